@@ -1,0 +1,32 @@
+#pragma once
+// Observer positions spread around a light, shared by the sampler
+// benchmarks so every sampler is timed on the same set of points.
+#include <vector>
+
+#include "mcrt/core/math.hpp"
+#include "mcrt/core/rng.hpp"
+
+namespace mcrt::bench {
+
+// n points in front of a light centred at `center` with unit front normal
+// `n`, at distances from 0.2 to 5 times `size`, in all directions of the
+// front half-space.
+inline std::vector<vec3> observers_around(const vec3& center, const vec3& n, float size,
+                                          std::size_t count = 4096) {
+  std::vector<vec3> out;
+  out.reserve(count);
+  pcg32 rng(7, 11);
+  while (out.size() < count) {
+    const vec3 d{2.0f * rng.uniform() - 1.0f, 2.0f * rng.uniform() - 1.0f, 2.0f * rng.uniform() - 1.0f};
+    const float l2 = glm::dot(d, d);
+    if (l2 > 1.0f || l2 < 1e-4f) continue;
+    vec3 dir = d / std::sqrt(l2);
+    if (glm::dot(dir, n) < 0.05f) dir = glm::reflect(dir, n);
+    if (glm::dot(dir, n) < 0.05f) continue;
+    const float dist = size * (0.2f + 4.8f * rng.uniform());
+    out.push_back(center + dist * dir);
+  }
+  return out;
+}
+
+}  // namespace mcrt::bench

@@ -1,0 +1,53 @@
+#pragma once
+// Sphere (Shirley, "Ray Tracing in One Weekend", sec. 5-6).
+#include "mcrt/core/ray.hpp"
+#include "mcrt/geometry/hit_record.hpp"
+
+namespace mcrt {
+
+struct sphere {
+  vec3 center{0.0f};
+  float radius = 1.0f;
+  bool flip = false;  // front side inside instead of outside
+
+  bool intersect(const ray& r, float tmin, float tmax, float& t) const {
+    // Half-b form; the discriminant is computed from the distance of the ray
+    // to the centre (Haines et al., "Precision Improvements for Ray/Sphere
+    // Intersection", Ray Tracing Gems ch. 7), which stays accurate when the
+    // sphere is small and far away.
+    const vec3 oc = r.o - center;
+    const float a = glm::dot(r.d, r.d);
+    const float half_b = glm::dot(oc, r.d);
+    const vec3 perp = oc - (half_b / a) * r.d;
+    const float disc = a * (radius * radius - glm::dot(perp, perp));
+    if (disc < 0.0f) return false;
+    const float sq = std::sqrt(disc);
+    // q = -(half_b + sign(half_b) sq) avoids cancellation; roots c/q and q/a.
+    const float q = -(half_b + std::copysign(sq, half_b));
+    const float c = glm::dot(oc, oc) - radius * radius;
+    float t0 = q / a, t1 = c / q;
+    if (t0 > t1) std::swap(t0, t1);
+    if (t0 > tmin && t0 < tmax) {
+      t = t0;
+      return true;
+    }
+    if (t1 > tmin && t1 < tmax) {
+      t = t1;
+      return true;
+    }
+    return false;
+  }
+
+  bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
+    float t;
+    if (!intersect(r, tmin, tmax, t)) return false;
+    rec.t = t;
+    rec.p = r.at(t);
+    const vec3 outward = (rec.p - center) / radius;
+    rec.n = flip ? -outward : outward;
+    rec.front_face = glm::dot(r.d, rec.n) < 0.0f;
+    return true;
+  }
+};
+
+}  // namespace mcrt

@@ -1,0 +1,45 @@
+#pragma once
+// Instancing (Shirley, "The Next Week", sec. 8): a shape is intersected in
+// its own frame by moving the ray there, instead of moving the shape.
+// rigid_y is Shirley's rotate_y followed by translate; transformed<S> wraps
+// any shape that has hit().
+#include "mcrt/core/ray.hpp"
+#include "mcrt/geometry/hit_record.hpp"
+
+namespace mcrt {
+
+// x_world = R_y(angle) x_local + offset.
+struct rigid_y {
+  float cos_t = 1.0f, sin_t = 0.0f;
+  vec3 offset{0.0f};
+
+  static rigid_y make(float degrees, const vec3& offset) {
+    const float r = glm::radians(degrees);
+    return {std::cos(r), std::sin(r), offset};
+  }
+  vec3 rotate(const vec3& v) const {  // local -> world direction
+    return {cos_t * v.x + sin_t * v.z, v.y, -sin_t * v.x + cos_t * v.z};
+  }
+  vec3 unrotate(const vec3& v) const {  // world -> local direction
+    return {cos_t * v.x - sin_t * v.z, v.y, sin_t * v.x + cos_t * v.z};
+  }
+  vec3 to_world(const vec3& p) const { return rotate(p) + offset; }
+  vec3 to_local(const vec3& p) const { return unrotate(p - offset); }
+  ray to_local(const ray& r) const { return {to_local(r.o), unrotate(r.d)}; }
+};
+
+template <class Shape>
+struct transformed {
+  Shape shape;
+  rigid_y xf;
+
+  bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
+    if (!shape.hit(xf.to_local(r), tmin, tmax, rec)) return false;
+    // A rigid motion keeps t; move point and normal back to the world.
+    rec.p = r.at(rec.t);
+    rec.n = xf.rotate(rec.n);
+    return true;
+  }
+};
+
+}  // namespace mcrt

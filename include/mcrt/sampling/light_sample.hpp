@@ -1,0 +1,35 @@
+#pragma once
+// The result of sampling a direction towards a shape from an observer, and
+// the interface every shape-sampling strategy offers (Shirley, "The Rest of
+// Your Life", sec. 9-10: hittable::random and hittable::pdf_value):
+//
+//   bool  sample(const vec3& o, vec2 u, light_sample& s) const;
+//           u in [0,1)^2 -> direction; false (and no sample) where the
+//           strategy has nothing to offer o, e.g. o behind a one-sided light.
+//   float pdf(const vec3& o, const vec3& dir) const;
+//           density of sample() per unit SOLID ANGLE at o for the unit
+//           direction dir; 0 where the ray misses the shape or sample()
+//           would return false.
+//   bool  faces(const vec3& o) const;
+//           whether sample() can return a direction for o at all.
+#include "mcrt/core/math.hpp"
+
+namespace mcrt {
+
+struct light_sample {
+  vec3 dir{0.0f};    // unit direction from the observer
+  float dist = 0.0f; // distance to the sampled point of the shape
+  float pdf = 0.0f;  // per unit solid angle
+};
+
+// Which strategy a light is sampled with; --light-sampling chooses one for
+// every light of a scene.
+enum class light_sampling { area, solid_angle };
+
+// Area density -> solid-angle density (Shirley, "The Rest of Your Life",
+// sec. 9; Veach 1997, eq. 8.10): p_w = p_A d^2 / |cos theta_light|.
+inline float area_to_solid_angle(float pdf_area, float dist2, float abs_cos_light) {
+  return pdf_area * dist2 / abs_cos_light;
+}
+
+}  // namespace mcrt

@@ -1,0 +1,59 @@
+#pragma once
+// Warps from the unit square to directions, each with its pdf and inverse
+// (names after Mitsuba 3's core/warp.h). Directions are in a local frame
+// with z as the axis.
+#include "mcrt/core/math.hpp"
+
+namespace mcrt {
+
+// --- cosine-weighted hemisphere (Malley's method via the polar disk map)
+inline vec3 square_to_cosine_hemisphere(vec2 u) {
+  const float r = std::sqrt(u.x), phi = two_pi * u.y;
+  const float x = r * std::cos(phi), y = r * std::sin(phi);
+  return {x, y, safe_sqrt(1.0f - u.x)};  // 1 - x^2 - y^2 may round below 0
+}
+// Density per unit solid angle: cos(theta) / pi on the upper hemisphere.
+inline float square_to_cosine_hemisphere_pdf(const vec3& d) {
+  return d.z > 0.0f ? d.z * inv_pi : 0.0f;
+}
+inline vec2 cosine_hemisphere_to_square(const vec3& d) {
+  float phi = std::atan2(d.y, d.x);
+  if (phi < 0.0f) phi += two_pi;
+  return {d.x * d.x + d.y * d.y, phi / two_pi};
+}
+
+// --- uniform sphere
+inline vec3 square_to_uniform_sphere(vec2 u) {
+  const float z = 1.0f - 2.0f * u.x;
+  const float r = safe_sqrt(1.0f - z * z), phi = two_pi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+// Density per unit solid angle: 1 / (4 pi).
+inline float square_to_uniform_sphere_pdf() { return 0.25f * inv_pi; }
+inline vec2 uniform_sphere_to_square(const vec3& d) {
+  float phi = std::atan2(d.y, d.x);
+  if (phi < 0.0f) phi += two_pi;
+  return {0.5f * (1.0f - d.z), phi / two_pi};
+}
+
+// --- uniform cone of half-angle theta_max around +z, given as
+// one_minus_cos = 1 - cos(theta_max), which stays accurate for narrow cones.
+inline vec3 square_to_uniform_cone(vec2 u, float one_minus_cos) {
+  const float omc = u.x * one_minus_cos;      // 1 - cos(theta)
+  const float z = 1.0f - omc;
+  const float r = safe_sqrt(omc * (2.0f - omc));  // sin(theta) without 1 - z^2 cancellation
+  const float phi = two_pi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+// Density per unit solid angle: 1 / (2 pi (1 - cos theta_max)) inside the cone.
+inline float square_to_uniform_cone_pdf(const vec3& d, float one_minus_cos) {
+  return (1.0f - d.z) <= one_minus_cos ? 1.0f / (two_pi * one_minus_cos) : 0.0f;
+}
+inline vec2 uniform_cone_to_square(const vec3& d, float one_minus_cos) {
+  float phi = std::atan2(d.y, d.x);
+  if (phi < 0.0f) phi += two_pi;
+  const float omc = (d.x * d.x + d.y * d.y) / (1.0f + d.z);  // 1 - cos, cancellation-free
+  return {omc / one_minus_cos, phi / two_pi};
+}
+
+}  // namespace mcrt
