@@ -1,0 +1,94 @@
+#pragma once
+// The materials of Shirley's books ("In One Weekend" sec. 8-10, "The Rest of
+// Your Life" sec. 10), as plain value types dispatched statically through
+// std::variant: a scene stores only the materials it names.
+#include <variant>
+
+#include "mcrt/core/ray.hpp"
+#include "mcrt/core/rng.hpp"
+#include "mcrt/geometry/hit_record.hpp"
+#include "mcrt/sampling/warp.hpp"
+
+namespace mcrt {
+
+// Ideal diffuse reflector: scattering pdf cos(theta)/pi (per unit solid angle).
+struct lambertian {
+  color albedo{0.5f};
+};
+
+// Mirror plus a random offset of up to `fuzz` in a unit ball.
+struct metal {
+  color albedo{0.8f};
+  float fuzz = 0.0f;
+};
+
+// Glass: refraction by Snell's law, reflection with Schlick's Fresnel term.
+struct dielectric {
+  float ior = 1.5f;
+};
+
+// Emits `emit` from its front side; scatters nothing.
+struct diffuse_light {
+  color emit{1.0f};
+};
+
+using material = std::variant<lambertian, metal, dielectric, diffuse_light>;
+
+// What a specular material does with an incoming ray.
+struct specular_scatter {
+  ray r;
+  color attenuation;
+};
+
+inline color emitted(const material& m, const hit_record& rec) {
+  if (const auto* l = std::get_if<diffuse_light>(&m)) return rec.front_face ? l->emit : color(0.0f);
+  return color(0.0f);
+}
+
+// Schlick's approximation of the Fresnel reflectance.
+inline float schlick(float cosine, float ior) {
+  float r0 = (1.0f - ior) / (1.0f + ior);
+  r0 *= r0;
+  const float m = 1.0f - cosine;
+  return r0 + (1.0f - r0) * (m * m) * (m * m) * m;
+}
+
+inline vec3 random_in_unit_ball(pcg32& rng) {
+  while (true) {
+    const vec3 p{2.0f * rng.uniform() - 1.0f, 2.0f * rng.uniform() - 1.0f, 2.0f * rng.uniform() - 1.0f};
+    if (glm::dot(p, p) < 1.0f) return p;
+  }
+}
+
+// Metal: reflection about the facing normal plus fuzz; absorbed when the
+// fuzzed direction points into the surface.
+inline bool scatter(const metal& m, const ray& in, const hit_record& rec, pcg32& rng, specular_scatter& out) {
+  const vec3 n = rec.facing_normal();
+  vec3 d = glm::reflect(glm::normalize(in.d), n);
+  if (m.fuzz > 0.0f) d += m.fuzz * random_in_unit_ball(rng);
+  out.r = {rec.p, d};
+  out.attenuation = m.albedo;
+  return glm::dot(d, n) > 0.0f;
+}
+
+// Dielectric: refract or reflect, choosing by the Fresnel reflectance.
+inline bool scatter(const dielectric& m, const ray& in, const hit_record& rec, pcg32& rng, specular_scatter& out) {
+  const float eta = rec.front_face ? (1.0f / m.ior) : m.ior;
+  const vec3 unit = glm::normalize(in.d);
+  const vec3 n = rec.facing_normal();
+  const float cos_t = std::min(glm::dot(-unit, n), 1.0f);
+  const float sin2_t = 1.0f - cos_t * cos_t;
+  vec3 d;
+  if (eta * eta * sin2_t > 1.0f || schlick(cos_t, m.ior) > rng.uniform()) {
+    d = glm::reflect(unit, n);
+  } else {
+    // Snell: perpendicular and parallel parts of the refracted direction.
+    const vec3 perp = eta * (unit + cos_t * n);
+    d = perp - safe_sqrt(1.0f - glm::dot(perp, perp)) * n;
+  }
+  out.r = {rec.p, d};
+  out.attenuation = color(1.0f);
+  return true;
+}
+
+}  // namespace mcrt

@@ -1,0 +1,33 @@
+#pragma once
+// Shirley's pinhole camera ("In One Weekend", sec. 11): vfov is the vertical
+// field of view in degrees; the image's horizontal axis is
+// cross(vup, lookfrom - lookat), its vertical axis vup projected.
+#include "mcrt/core/ray.hpp"
+
+namespace mcrt {
+
+class camera {
+ public:
+  camera() = default;
+  camera(const vec3& lookfrom, const vec3& lookat, const vec3& vup, float vfov_degrees, float aspect) {
+    const float h = std::tan(glm::radians(vfov_degrees) * 0.5f);
+    const float viewport_h = 2.0f * h, viewport_w = aspect * viewport_h;
+    const vec3 w = glm::normalize(lookfrom - lookat);
+    const vec3 u = glm::normalize(glm::cross(vup, w));
+    const vec3 v = glm::cross(w, u);
+    origin_ = lookfrom;
+    horizontal_ = viewport_w * u;
+    vertical_ = viewport_h * v;
+    upper_left_ = origin_ - 0.5f * horizontal_ + 0.5f * vertical_ - w;
+  }
+
+  // (s, t) in [0,1]^2 over the image, s to the right, t downwards (row order).
+  ray generate(float s, float t) const {
+    return {origin_, upper_left_ + s * horizontal_ - t * vertical_ - origin_};
+  }
+
+ private:
+  vec3 origin_{0.0f}, upper_left_{0.0f}, horizontal_{0.0f}, vertical_{0.0f};
+};
+
+}  // namespace mcrt

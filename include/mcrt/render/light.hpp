@@ -1,0 +1,34 @@
+#pragma once
+// The lights of a scene: every shape that is sampled directly, each with its
+// sampling strategy, in one std::variant so a scene holds exactly the
+// strategies it uses and dispatch is a jump, not a virtual call.
+#include <variant>
+
+#include "mcrt/sampling/ellipse_area.hpp"
+#include "mcrt/sampling/rect_area.hpp"
+#include "mcrt/sampling/sphere_cone.hpp"
+
+namespace mcrt {
+
+using light = std::variant<rect_area_sampler, ellipse_area_sampler, sphere_cone_sampler>;
+
+// The free functions light_pdf (render/pdf.hpp) calls: the strategy's own
+// members for a plain strategy, a visit for the variant.
+template <class S>
+bool faces(const S& s, const vec3& o) { return s.faces(o); }
+template <class S>
+bool sample(const S& s, const vec3& o, vec2 u, light_sample& out) { return s.sample(o, u, out); }
+template <class S>
+float pdf(const S& s, const vec3& o, const vec3& dir) { return s.pdf(o, dir); }
+
+inline bool faces(const light& l, const vec3& o) {
+  return std::visit([&](const auto& s) { return s.faces(o); }, l);
+}
+inline bool sample(const light& l, const vec3& o, vec2 u, light_sample& out) {
+  return std::visit([&](const auto& s) { return s.sample(o, u, out); }, l);
+}
+inline float pdf(const light& l, const vec3& o, const vec3& dir) {
+  return std::visit([&](const auto& s) { return s.pdf(o, dir); }, l);
+}
+
+}  // namespace mcrt

@@ -1,0 +1,105 @@
+#pragma once
+// Shirley's path tracer ("The Rest of Your Life", sec. 10-12), iterative:
+// emission where a path meets a light's front side; at each diffuse bounce
+// the next direction is drawn from the 50/50 mixture of the lights' pdf and
+// the cosine pdf, and weighted by scattering pdf / mixture pdf; specular
+// materials follow their ray. No heap allocation per bounce.
+#include "mcrt/core/rng.hpp"
+#include "mcrt/render/pdf.hpp"
+#include "mcrt/render/scene.hpp"
+
+namespace mcrt {
+
+struct path_settings {
+  int max_depth = 50;  // maximum number of scattering events along a path
+  // Russian roulette (Arvo & Kirk 1990) from this many scattering events on:
+  // a path survives each further scattering with probability
+  // q = min(max albedo component, 0.95) and its throughput is divided by q,
+  // which keeps the estimator unbiased while cutting the long tail of paths.
+  // A value >= max_depth turns it off.
+  int rr_depth = 3;
+};
+
+// Survival probability of Russian roulette at a surface of this albedo.
+inline float survival_probability(const color& albedo) {
+  return std::min(std::max({albedo.r, albedo.g, albedo.b}), 0.95f);
+}
+
+template <class Scene>
+color trace_path(const Scene& sc, ray r, pcg32& rng, const path_settings& ps) {
+  color radiance(0.0f), throughput(1.0f);
+  for (int depth = 0;; ++depth) {
+    hit_record rec;
+    if (!sc.hit(r, sc.ray_epsilon, infinity, rec)) {
+      radiance += throughput * sc.background;
+      break;
+    }
+    const material& m = sc.materials[rec.material];
+    if (const auto* l = std::get_if<diffuse_light>(&m)) {
+      if (rec.front_face) radiance += throughput * l->emit;
+      break;
+    }
+    if (depth == ps.max_depth) break;
+    if (depth >= ps.rr_depth) {
+      const float q = std::visit(
+          [](const auto& mat) {
+            using M = std::decay_t<decltype(mat)>;
+            if constexpr (std::is_same_v<M, dielectric>)
+              return 0.95f;
+            else if constexpr (std::is_same_v<M, diffuse_light>)
+              return 0.0f;
+            else
+              return survival_probability(mat.albedo);
+          },
+          m);
+      if (!(rng.uniform() < q)) break;
+      throughput /= q;
+    }
+
+    if (const auto* lam = std::get_if<lambertian>(&m)) {
+      const vec3 n = rec.facing_normal();
+      const cosine_pdf cos_pdf(n);
+      const light_pdf<light> lights(sc.lights, rec.p);
+      const float u_select = rng.uniform();
+      const vec2 u = rng.uniform2();
+      vec3 dir;
+      float p;
+      if (lights.empty()) {
+        dir = cos_pdf.generate(u);
+        p = cos_pdf.value(dir);
+      } else if (u_select < 0.5f) {
+        dir = cos_pdf.generate(u);
+        p = mixture_value(cos_pdf.value(dir), lights.value(dir));
+      } else {
+        light_sample s;
+        const std::ptrdiff_t k = lights.generate(2.0f * u_select - 1.0f, u, s);
+        if (k < 0) break;  // the chosen light had no direction to offer: zero-valued sample
+        dir = s.dir;
+        p = mixture_value(cos_pdf.value(dir), lights.value(dir, k, s.pdf));
+      }
+      const float cos_theta = glm::dot(dir, n);
+      // Below the surface the scattering pdf is 0: the path carries nothing more.
+      if (!(cos_theta > 0.0f) || !(p > 0.0f)) break;
+      throughput *= lam->albedo * (cos_theta * inv_pi / p);
+      r = {rec.p, dir};
+      continue;
+    }
+
+    specular_scatter sp;
+    const bool scattered = std::visit(
+        [&](const auto& mat) -> bool {
+          using M = std::decay_t<decltype(mat)>;
+          if constexpr (std::is_same_v<M, metal> || std::is_same_v<M, dielectric>)
+            return scatter(mat, r, rec, rng, sp);
+          else
+            return false;
+        },
+        m);
+    if (!scattered) break;
+    throughput *= sp.attenuation;
+    r = sp.r;
+  }
+  return radiance;
+}
+
+}  // namespace mcrt

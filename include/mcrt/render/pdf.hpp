@@ -1,0 +1,78 @@
+#pragma once
+// Shirley's pdf classes ("The Rest of Your Life", sec. 9-11): a pdf over
+// directions that can both generate a direction and give its density per
+// unit SOLID ANGLE. Value types built on the stack at each bounce (no heap),
+// composed statically.
+#include <cstddef>
+#include <span>
+
+#include "mcrt/core/onb.hpp"
+#include "mcrt/sampling/light_sample.hpp"
+#include "mcrt/sampling/warp.hpp"
+
+namespace mcrt {
+
+// Cosine-weighted directions about a unit normal: density cos(theta)/pi per
+// unit solid angle on the normal's hemisphere.
+class cosine_pdf {
+ public:
+  explicit cosine_pdf(const vec3& n) : uvw_(n) {}
+  float value(const vec3& dir) const { return std::max(glm::dot(dir, uvw_.w), 0.0f) * inv_pi; }
+  vec3 generate(vec2 u) const { return glm::normalize(uvw_.to_world(square_to_cosine_hemisphere(u))); }
+
+ private:
+  onb uvw_;
+};
+
+// Shirley's hittable_pdf over a list of lights: a light is picked uniformly
+// among those that can offer o a sample (Light::faces), then sampled. The
+// density is the average of their densities; lights that face away from o
+// take no part, so the mixture stays normalised.
+//
+// Light is any type with faces/sample/pdf (see sampling/light_sample.hpp),
+// or a std::variant of such types through the visit in light.hpp.
+template <class Light>
+class light_pdf {
+ public:
+  light_pdf(std::span<const Light> lights, const vec3& o) : lights_(lights), o_(o) {
+    for (const Light& l : lights_) count_ += faces(l, o_) ? 1 : 0;
+  }
+
+  bool empty() const { return count_ == 0; }
+
+  // u_pick in [0,1) chooses the light, u samples it. Returns the index of the
+  // light chosen (or -1 when it gave no sample).
+  std::ptrdiff_t generate(float u_pick, vec2 u, light_sample& s) const {
+    std::size_t k = std::min(static_cast<std::size_t>(u_pick * static_cast<float>(count_)), count_ - 1);
+    for (std::size_t i = 0; i < lights_.size(); ++i) {
+      if (!faces(lights_[i], o_)) continue;
+      if (k-- == 0) return sample(lights_[i], o_, u, s) ? static_cast<std::ptrdiff_t>(i) : -1;
+    }
+    return -1;
+  }
+
+  // Density per unit solid angle of dir (unit).
+  float value(const vec3& dir) const { return value(dir, -1, 0.0f); }
+
+  // Same, when light `known` is already known to have density known_pdf at
+  // dir (the light the direction was sampled from): saves its evaluation.
+  float value(const vec3& dir, std::ptrdiff_t known, float known_pdf) const {
+    if (count_ == 0) return 0.0f;
+    float sum = 0.0f;
+    for (std::size_t i = 0; i < lights_.size(); ++i)
+      sum += static_cast<std::ptrdiff_t>(i) == known ? known_pdf : pdf(lights_[i], o_, dir);
+    return sum / static_cast<float>(count_);
+  }
+
+ private:
+  std::span<const Light> lights_;
+  vec3 o_;
+  std::size_t count_ = 0;
+};
+
+// Shirley's mixture_pdf with equal weights, as in the book and the seed.
+// Evaluation only; generation is done by choosing one of the two with a
+// random number (see render/path_tracer.hpp).
+inline float mixture_value(float p0, float p1) { return 0.5f * (p0 + p1); }
+
+}  // namespace mcrt

@@ -1,0 +1,204 @@
+// The mcrt executable: `mcrt render` and `mcrt diff` (shared/spec cli.md).
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <iostream>
+#include <optional>
+#include <string>
+
+#include "image_io.hpp"
+#include "mcrt/mcrt.hpp"
+#include "scene_loader.hpp"
+
+namespace {
+
+using namespace mcrt;
+using namespace mcrt::cli;
+
+struct render_options {
+  std::string scene, output, stats, light_sampling;
+  std::optional<int> spp, width, height, max_depth;
+  std::optional<unsigned> threads;
+  std::uint64_t seed = 0;
+  bool quiet = false;
+};
+
+struct diff_options {
+  std::string image, reference;
+  bool json = false;
+};
+
+void check_range(const std::optional<int>& v, const char* flag, int lo, int hi) {
+  if (v && (*v < lo || *v > hi))
+    throw input_error(std::string(flag) + ": must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                      "], got " + std::to_string(*v));
+}
+
+std::string strategy_name(light_sampling s) { return s == light_sampling::area ? "area" : "solid-angle"; }
+
+// What the lights of a scene use, for --stats: "area", "solid-angle",
+// "mixed" or "none".
+std::string strategy_summary(const scene& world) {
+  bool area = false, sa = false;
+  for (const light& l : world.lights) {
+    std::visit(
+        [&](const auto& s) {
+          using S = std::decay_t<decltype(s)>;
+          if constexpr (std::is_same_v<S, rect_area_sampler> || std::is_same_v<S, ellipse_area_sampler>)
+            area = true;
+          else if constexpr (!std::is_same_v<S, sphere_cone_sampler>)  // spheres have one strategy only
+            sa = true;
+        },
+        l);
+  }
+  return area && sa ? "mixed" : area ? "area" : sa ? "solid-angle" : "none";
+}
+
+void print_progress(double fraction, double elapsed) {
+  const double eta = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
+  std::fprintf(stderr, "\rrendering %5.1f%%  elapsed %7.1f s  ETA %7.1f s", 100.0 * fraction, elapsed, eta);
+  if (fraction >= 1.0) std::fputc('\n', stderr);
+  std::fflush(stderr);
+}
+
+int run_render(const render_options& opt) {
+  check_range(opt.spp, "--spp", 1, max_spp);
+  check_range(opt.width, "--width", 1, max_resolution);
+  check_range(opt.height, "--height", 1, max_resolution);
+  check_range(opt.max_depth, "--max-depth", 0, max_depth_limit);
+  if (opt.threads && *opt.threads == 0) throw input_error("--threads: must be >= 1");
+  std::optional<light_sampling> strategy;
+  if (!opt.light_sampling.empty())
+    strategy = opt.light_sampling == "area" ? light_sampling::area : light_sampling::solid_angle;
+
+  loaded_scene ls = load_scene(opt.scene, strategy);
+  const std::string output = opt.output.empty() ? ls.name + ".exr" : opt.output;
+  check_writable(output, true);
+  if (!opt.stats.empty()) check_writable(opt.stats, false);
+
+  render_settings rs;
+  // The camera keeps the scene's aspect ratio: --width/--height change the
+  // sampling resolution, not the view.
+  const camera cam(ls.cam.lookfrom, ls.cam.lookat, ls.cam.vup, ls.cam.vfov,
+                   static_cast<float>(ls.cam.width) / static_cast<float>(ls.cam.height));
+  rs.width = opt.width.value_or(ls.cam.width);
+  rs.height = opt.height.value_or(ls.cam.height);
+  rs.spp = opt.spp.value_or(ls.spp);
+  rs.max_depth = opt.max_depth.value_or(ls.max_depth);
+  rs.seed = opt.seed;
+  rs.threads = opt.threads.value_or(0u);
+
+  const render_result res = render(ls.world, cam, rs, opt.quiet ? progress_callback{} : progress_callback(print_progress));
+  const double samples = static_cast<double>(rs.width) * rs.height * rs.spp;
+  const std::string strategy_used = strategy ? strategy_name(*strategy) : strategy_summary(ls.world);
+  if (res.nonfinite_samples && !opt.quiet)
+    std::fprintf(stderr, "mcrt: %llu non-finite radiance samples were dropped\n",
+                 static_cast<unsigned long long>(res.nonfinite_samples));
+
+  write_image(output, res.img,
+              {{"mcrt:render_seconds", "", res.seconds, true, false},
+               {"mcrt:spp", "", static_cast<double>(rs.spp), true, true},
+               {"mcrt:seed", std::to_string(rs.seed)},
+               {"mcrt:light_sampling", strategy_used},
+               {"mcrt:scene", ls.name}});
+  if (!opt.stats.empty()) {
+    nlohmann::ordered_json j;
+    j["render_seconds"] = res.seconds;
+    j["spp"] = rs.spp;
+    j["width"] = rs.width;
+    j["height"] = rs.height;
+    j["threads"] = res.threads;
+    j["samples_per_second"] = samples / res.seconds;
+    j["light_sampling"] = strategy_used;
+    j["seed"] = rs.seed;
+    j["max_depth"] = rs.max_depth;
+    j["scene"] = ls.name;
+    j["nonfinite_samples"] = res.nonfinite_samples;
+    write_text(opt.stats, j.dump(2) + "\n");
+  }
+  return 0;
+}
+
+int run_diff(const diff_options& opt) {
+  const image a = read_image(opt.image), r = read_image(opt.reference);
+  if (a.width != r.width || a.height != r.height)
+    throw input_error("images differ in size: " + opt.image + " is " + std::to_string(a.width) + "x" +
+                      std::to_string(a.height) + ", " + opt.reference + " is " + std::to_string(r.width) + "x" +
+                      std::to_string(r.height));
+  // Accumulated in double over all pixels and channels.
+  double se = 0.0, rel = 0.0, sum_a = 0.0, sum_r = 0.0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double v = a.pixels[i][c], ref = r.pixels[i][c];
+      se += (v - ref) * (v - ref);
+      rel += (v - ref) * (v - ref) / ((ref + 0.01) * (ref + 0.01));  // pbrt's relative MSE
+      sum_a += v;
+      sum_r += ref;
+    }
+  const double n = 3.0 * static_cast<double>(a.pixels.size());
+  const double mse = se / n, relmse = rel / n;
+  // Signed difference of the mean values, in percent of the reference's.
+  const double mean_diff = sum_r != 0.0 ? 100.0 * (sum_a - sum_r) / sum_r : (sum_a == 0.0 ? 0.0 : 100.0);
+  if (opt.json) {
+    nlohmann::ordered_json j;
+    j["rmse"] = std::sqrt(mse);
+    j["mse"] = mse;
+    j["relmse"] = relmse;
+    j["mean_diff_percent"] = mean_diff;
+    std::cout << j.dump() << "\n";
+  } else {
+    std::printf("rmse %.9g\nmse %.9g\nrelmse %.9g\nmean_diff_percent %.9g\n", std::sqrt(mse), mse, relmse, mean_diff);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"mcrt: a Monte-Carlo path tracer for comparing direct sampling of area lights"};
+  app.require_subcommand(1);
+
+  render_options ro;
+  CLI::App* render_cmd = app.add_subcommand("render", "Render a scene file to an image");
+  render_cmd->add_option("scene", ro.scene, "Scene file (JSON)")->required();
+  render_cmd->add_option("-o,--output", ro.output, "Output image: .exr, .png or .ppm (default SCENE-NAME.exr)");
+  render_cmd->add_option("--spp", ro.spp, "Samples per pixel (overrides the scene)");
+  render_cmd->add_option("--width", ro.width, "Image width in pixels (overrides the scene; keeps the view)");
+  render_cmd->add_option("--height", ro.height, "Image height in pixels (overrides the scene; keeps the view)");
+  render_cmd->add_option("--max-depth", ro.max_depth, "Maximum number of scattering events (overrides the scene)");
+  render_cmd->add_option("--seed", ro.seed, "Random seed (default 0)");
+  render_cmd->add_option("--threads", ro.threads, "Threads (default: all hardware threads)");
+  render_cmd->add_option("--light-sampling", ro.light_sampling, "Sample every light by area or solid angle")
+      ->check(CLI::IsMember({"area", "solid-angle"}));
+  render_cmd->add_option("--stats", ro.stats, "Write render statistics as JSON to this file");
+  render_cmd->add_flag("--quiet", ro.quiet, "No progress line");
+
+  diff_options dop;
+  CLI::App* diff_cmd = app.add_subcommand("diff", "Compare an image with a reference");
+  diff_cmd->add_option("image", dop.image, "Image")->required();
+  diff_cmd->add_option("reference", dop.reference, "Reference image")->required();
+  diff_cmd->add_flag("--json", dop.json, "Print one JSON object");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::string msg = e.what();
+    std::replace(msg.begin(), msg.end(), '\n', ' ');
+    std::fprintf(stderr, "mcrt: %s (see mcrt --help)\n", msg.c_str());
+    return 2;
+  }
+  try {
+    return render_cmd->parsed() ? run_render(ro) : run_diff(dop);
+  } catch (const input_error& e) {
+    std::fprintf(stderr, "mcrt: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mcrt: error: %s\n", e.what());
+    return 1;
+  }
+}

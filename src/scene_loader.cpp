@@ -1,0 +1,351 @@
+#include "scene_loader.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+namespace mcrt::cli {
+namespace {
+
+using json = nlohmann::json;
+
+// Error reporting bound to one file: fail("objects[3].radius", "must be > 0").
+struct context {
+  std::string file;
+  [[noreturn]] void fail(const std::string& place, const std::string& what) const {
+    throw input_error(file + ": " + (place.empty() ? "" : place + ": ") + what);
+  }
+};
+
+std::string join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
+
+const char* type_name(const json& j) {
+  switch (j.type()) {
+    case json::value_t::null: return "null";
+    case json::value_t::boolean: return "a boolean";
+    case json::value_t::string: return "a string";
+    case json::value_t::array: return "an array";
+    case json::value_t::object: return "an object";
+    default: return "a number";
+  }
+}
+
+// Accessors that check presence, type and finiteness.
+struct reader {
+  const context& ctx;
+
+  const json& field(const json& obj, const std::string& path, const std::string& key) const {
+    const auto it = obj.find(key);
+    if (it == obj.end()) ctx.fail(join(path, key), "missing required field");
+    return *it;
+  }
+  double number(const json& j, const std::string& place) const {
+    if (!j.is_number()) ctx.fail(place, std::string("expected a number, got ") + type_name(j));
+    const double v = j.get<double>();
+    if (!std::isfinite(v)) ctx.fail(place, "number is not finite");
+    return v;
+  }
+  double number(const json& obj, const std::string& path, const std::string& key) const {
+    return number(field(obj, path, key), join(path, key));
+  }
+  double number_or(const json& obj, const std::string& path, const std::string& key, double dflt) const {
+    return obj.contains(key) ? number(obj, path, key) : dflt;
+  }
+  int integer(const json& obj, const std::string& path, const std::string& key, int lo, int hi) const {
+    const json& j = field(obj, path, key);
+    const std::string place = join(path, key);
+    const double v = number(j, place);
+    if (v != std::floor(v)) ctx.fail(place, "expected an integer, got " + j.dump());
+    if (v < lo || v > hi)
+      ctx.fail(place, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + j.dump());
+    return static_cast<int>(v);
+  }
+  vec3 vector3(const json& obj, const std::string& path, const std::string& key) const {
+    const json& j = field(obj, path, key);
+    const std::string place = join(path, key);
+    if (!j.is_array() || j.size() != 3)
+      ctx.fail(place, std::string("expected an array of 3 numbers, got ") + (j.is_array() ? "an array of " + std::to_string(j.size()) : type_name(j)));
+    vec3 v;
+    for (int i = 0; i < 3; ++i) v[i] = static_cast<float>(number(j[static_cast<std::size_t>(i)], place + "[" + std::to_string(i) + "]"));
+    if (!all_finite(v)) ctx.fail(place, "number is not finite in single precision");
+    return v;
+  }
+  vec3 vector3_or(const json& obj, const std::string& path, const std::string& key, vec3 dflt) const {
+    return obj.contains(key) ? vector3(obj, path, key) : dflt;
+  }
+  bool boolean_or(const json& obj, const std::string& path, const std::string& key, bool dflt) const {
+    if (!obj.contains(key)) return dflt;
+    const json& j = obj[key];
+    if (!j.is_boolean()) ctx.fail(join(path, key), std::string("expected true or false, got ") + type_name(j));
+    return j.get<bool>();
+  }
+  std::string string(const json& obj, const std::string& path, const std::string& key) const {
+    const json& j = field(obj, path, key);
+    if (!j.is_string()) ctx.fail(join(path, key), std::string("expected a string, got ") + type_name(j));
+    return j.get<std::string>();
+  }
+  const json& object(const json& obj, const std::string& path, const std::string& key) const {
+    const json& j = field(obj, path, key);
+    if (!j.is_object()) ctx.fail(join(path, key), std::string("expected an object, got ") + type_name(j));
+    return j;
+  }
+  // Fields a part of the scene may have; anything else is refused, so a
+  // misspelt optional field ("flipp") is not silently ignored.
+  void only(const json& obj, const std::string& path, std::initializer_list<const char*> allowed) const {
+    for (const auto& [k, v] : obj.items()) {
+      bool ok = false;
+      for (const char* a : allowed) ok = ok || k == a;
+      if (!ok) {
+        std::string list;
+        for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+        ctx.fail(join(path, k), "unknown field (expected one of: " + list + ")");
+      }
+    }
+  }
+};
+
+float positive(const reader& rd, const json& obj, const std::string& path, const std::string& key) {
+  const double v = rd.number(obj, path, key);
+  if (!(v > 0.0)) rd.ctx.fail(join(path, key), "must be > 0, got " + obj[key].dump());
+  return static_cast<float>(v);
+}
+
+color non_negative_color(const reader& rd, const json& obj, const std::string& path, const std::string& key) {
+  const vec3 c = rd.vector3(obj, path, key);
+  if (c.x < 0 || c.y < 0 || c.z < 0) rd.ctx.fail(join(path, key), "components must be >= 0");
+  return c;
+}
+
+material read_material(const reader& rd, const json& m, const std::string& path) {
+  if (!m.is_object()) rd.ctx.fail(path, std::string("expected an object, got ") + type_name(m));
+  const std::string type = rd.string(m, path, "type");
+  if (type == "lambertian") {
+    rd.only(m, path, {"type", "albedo"});
+    return lambertian{non_negative_color(rd, m, path, "albedo")};
+  }
+  if (type == "metal") {
+    rd.only(m, path, {"type", "albedo", "fuzz"});
+    const double fuzz = rd.number_or(m, path, "fuzz", 0.0);
+    if (fuzz < 0.0 || fuzz > 1.0) rd.ctx.fail(join(path, "fuzz"), "must be in [0, 1]");
+    return metal{non_negative_color(rd, m, path, "albedo"), static_cast<float>(fuzz)};
+  }
+  if (type == "dielectric") {
+    rd.only(m, path, {"type", "ior"});
+    return dielectric{positive(rd, m, path, "ior")};
+  }
+  if (type == "diffuse_light") {
+    rd.only(m, path, {"type", "emit"});
+    return diffuse_light{non_negative_color(rd, m, path, "emit")};
+  }
+  rd.ctx.fail(join(path, "type"),
+              "unknown material type '" + type + "' (expected lambertian, metal, dielectric or diffuse_light)");
+}
+
+// Two edges/semi-axes that must be non-zero and orthogonal.
+void check_frame(const reader& rd, const std::string& path, const char* k1, const char* k2, vec3 a, vec3 b) {
+  const float la = glm::length(a), lb = glm::length(b);
+  if (!(la > 0.0f)) rd.ctx.fail(join(path, k1), "must be a non-zero vector (degenerate shape)");
+  if (!(lb > 0.0f)) rd.ctx.fail(join(path, k2), "must be a non-zero vector (degenerate shape)");
+  if (std::abs(glm::dot(a, b)) > 1e-4f * la * lb)
+    rd.ctx.fail(path, std::string(k1) + " and " + k2 + " must be orthogonal");
+  if (!(glm::length(glm::cross(a, b)) > 0.0f) || !std::isfinite(la * lb))
+    rd.ctx.fail(path, "degenerate shape (zero or non-representable area)");
+}
+
+// Reads `lo`..`hi` of an axis-aligned rectangle, which must span a non-empty interval.
+std::pair<float, float> interval(const reader& rd, const json& o, const std::string& path, const char* lo, const char* hi) {
+  const float a = static_cast<float>(rd.number(o, path, lo)), b = static_cast<float>(rd.number(o, path, hi));
+  if (!(b > a))
+    rd.ctx.fail(path, std::string(hi) + " must be greater than " + lo + " (zero-area or inverted rectangle)");
+  return {a, b};
+}
+
+struct shape_strategy {
+  bool solid_angle = false;
+};
+
+// Adds the light (or importance target) for a shape, with its strategy.
+template <class Shape>
+void add_light(const reader& rd, scene& world, const Shape& s, light_sampling strategy, const std::string& path) {
+  if constexpr (std::is_same_v<Shape, rect>) {
+    if (strategy == light_sampling::area) {
+      world.lights.emplace_back(rect_area_sampler{s});
+      return;
+    }
+  } else if constexpr (std::is_same_v<Shape, ellipse>) {
+    if (strategy == light_sampling::area) {
+      world.lights.emplace_back(ellipse_area_sampler{s});
+      return;
+    }
+  } else if constexpr (std::is_same_v<Shape, sphere>) {
+    // A sphere is sampled by its cone of directions (solid angle) under
+    // either strategy: there is no area strategy for spheres.
+    world.lights.emplace_back(sphere_cone_sampler{s});
+    return;
+  }
+  rd.ctx.fail(join(path, "type"), "solid-angle sampling of this shape is not available in this build");
+}
+
+void read_object(const reader& rd, const json& o, const std::string& path, scene& world,
+                 const std::map<std::string, std::uint32_t>& material_ids,
+                 std::optional<light_sampling> override_strategy) {
+  if (!o.is_object()) rd.ctx.fail(path, std::string("expected an object, got ") + type_name(o));
+  std::string type = rd.string(o, path, "type");
+  const std::string mat_name = rd.string(o, path, "material");
+  const auto mit = material_ids.find(mat_name);
+  if (mit == material_ids.end()) rd.ctx.fail(join(path, "material"), "unknown material '" + mat_name + "'");
+  const std::uint32_t mat = mit->second;
+  const bool flip = rd.boolean_or(o, path, "flip", false);
+  const bool is_light = std::holds_alternative<diffuse_light>(world.materials[mat]);
+  const bool sampled = rd.boolean_or(o, path, "sample", false) || is_light;
+
+  light_sampling strategy = light_sampling::area;
+  if (type.size() > 3 && type.ends_with("_sa")) {
+    strategy = light_sampling::solid_angle;
+    type.resize(type.size() - 3);
+    if (type != "xz_rect" && type != "xy_rect" && type != "yz_rect" && type != "rect" && type != "ellipse")
+      rd.ctx.fail(join(path, "type"), "unknown object type '" + type + "_sa'");
+  }
+  if (override_strategy) strategy = *override_strategy;
+
+  auto add = [&](const auto& shape) {
+    world.add(shape, mat);
+    if (sampled) add_light(rd, world, shape, strategy, path);
+  };
+
+  if (type == "xz_rect" || type == "xy_rect" || type == "yz_rect") {
+    const char a = type[0], b = type[1];
+    const std::string a0 = std::string(1, a) + "0", a1 = std::string(1, a) + "1";
+    const std::string b0 = std::string(1, b) + "0", b1 = std::string(1, b) + "1";
+    rd.only(o, path, {"type", "material", "flip", "sample", a0.c_str(), a1.c_str(), b0.c_str(), b1.c_str(), "k"});
+    const auto [u0, u1] = interval(rd, o, path, a0.c_str(), a1.c_str());
+    const auto [v0, v1] = interval(rd, o, path, b0.c_str(), b1.c_str());
+    const float k = static_cast<float>(rd.number(o, path, "k"));
+    // Intersected as an axis-aligned shape; sampled as the general rectangle.
+    auto add_axis = [&](auto shape) {
+      shape.k = k;
+      shape.flip = flip;
+      world.add(shape, mat);
+      if (sampled) add_light(rd, world, shape.to_rect(), strategy, path);
+    };
+    if (type == "xz_rect")
+      add_axis(xz_rect_shape{v0, v1, u0, u1});  // in-plane axes (z, x)
+    else if (type == "xy_rect")
+      add_axis(xy_rect_shape{u0, u1, v0, v1});  // (x, y)
+    else
+      add_axis(yz_rect_shape{u0, u1, v0, v1});  // (y, z)
+  } else if (type == "rect") {
+    rd.only(o, path, {"type", "material", "flip", "sample", "corner", "edge1", "edge2"});
+    const vec3 c = rd.vector3(o, path, "corner"), e1 = rd.vector3(o, path, "edge1"), e2 = rd.vector3(o, path, "edge2");
+    check_frame(rd, path, "edge1", "edge2", e1, e2);
+    add(rect::make(c, e1, e2, flip));
+  } else if (type == "ellipse") {
+    rd.only(o, path, {"type", "material", "flip", "sample", "center", "axis1", "axis2"});
+    const vec3 c = rd.vector3(o, path, "center"), a1 = rd.vector3(o, path, "axis1"), a2 = rd.vector3(o, path, "axis2");
+    check_frame(rd, path, "axis1", "axis2", a1, a2);
+    add(ellipse::make(c, a1, a2, flip));
+  } else if (type == "sphere") {
+    rd.only(o, path, {"type", "material", "flip", "sample", "center", "radius"});
+    add(sphere{rd.vector3(o, path, "center"), positive(rd, o, path, "radius"), flip});
+  } else if (type == "box") {
+    rd.only(o, path, {"type", "material", "flip", "sample", "min", "max", "rotate_y", "translate"});
+    const vec3 lo = rd.vector3(o, path, "min"), hi = rd.vector3(o, path, "max");
+    if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z))
+      rd.ctx.fail(join(path, "max"), "must be greater than min in every coordinate (degenerate box)");
+    if (sampled)
+      rd.ctx.fail(path, is_light ? "a box cannot be a light (boxes have no direct sampling strategy)"
+                                 : "a box cannot be sampled (boxes have no direct sampling strategy)");
+    const float angle = static_cast<float>(rd.number_or(o, path, "rotate_y", 0.0));
+    const vec3 t = rd.vector3_or(o, path, "translate", vec3(0.0f));
+    world.add(box{lo, hi, rigid_y::make(angle, t), flip}, mat);
+  } else {
+    rd.ctx.fail(join(path, "type"), "unknown object type '" + type + "'");
+  }
+}
+
+}  // namespace
+
+loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy) {
+  const context ctx{path};
+  const reader rd{ctx};
+  std::ifstream in(path, std::ios::binary);
+  if (!in) ctx.fail("", "cannot open the scene file");
+  if (std::filesystem::is_directory(path)) ctx.fail("", "is a directory, not a scene file");
+  json root;
+  try {
+    root = json::parse(in);
+  } catch (const json::parse_error& e) {
+    std::string what = e.what();
+    // "[json.exception.parse_error.101] parse error at line 3, column 5: ..." -> keep the readable part.
+    if (const auto p = what.find("parse error"); p != std::string::npos) what = what.substr(p);
+    ctx.fail("", "invalid JSON: " + what);
+  }
+  if (!root.is_object()) ctx.fail("", std::string("expected a JSON object at the top level, got ") + type_name(root));
+  rd.only(root, "", {"camera", "render", "materials", "objects"});
+
+  loaded_scene out;
+  out.name = std::filesystem::path(path).stem().string();
+
+  // camera
+  const json& cam = rd.object(root, "", "camera");
+  rd.only(cam, "camera", {"lookfrom", "lookat", "vup", "vfov", "width", "height"});
+  out.cam.lookfrom = rd.vector3(cam, "camera", "lookfrom");
+  out.cam.lookat = rd.vector3(cam, "camera", "lookat");
+  out.cam.vup = rd.vector3_or(cam, "camera", "vup", vec3(0.0f, 1.0f, 0.0f));
+  out.cam.vfov = static_cast<float>(rd.number(cam, "camera", "vfov"));
+  if (!(out.cam.vfov > 0.0f && out.cam.vfov < 180.0f)) ctx.fail("camera.vfov", "must be in (0, 180) degrees");
+  out.cam.width = rd.integer(cam, "camera", "width", 1, max_resolution);
+  out.cam.height = rd.integer(cam, "camera", "height", 1, max_resolution);
+  const vec3 view = out.cam.lookfrom - out.cam.lookat;
+  if (!(glm::length(view) > 0.0f)) ctx.fail("camera.lookat", "must differ from lookfrom");
+  if (!(glm::length(glm::cross(out.cam.vup, view)) > 1e-6f * glm::length(view) * glm::length(out.cam.vup)))
+    ctx.fail("camera.vup", "must not be zero or parallel to the viewing direction");
+
+  // render
+  if (root.contains("render")) {
+    const json& r = rd.object(root, "", "render");
+    rd.only(r, "render", {"spp", "max_depth", "background"});
+    if (r.contains("spp")) out.spp = rd.integer(r, "render", "spp", 1, max_spp);
+    if (r.contains("max_depth")) out.max_depth = rd.integer(r, "render", "max_depth", 0, max_depth_limit);
+    out.world.background = rd.vector3_or(r, "render", "background", color(0.0f));
+  }
+
+  // materials
+  const json& mats = rd.object(root, "", "materials");
+  std::map<std::string, std::uint32_t> ids;
+  for (const auto& [name, m] : mats.items()) {
+    ids[name] = static_cast<std::uint32_t>(out.world.materials.size());
+    out.world.materials.push_back(read_material(rd, m, "materials." + name));
+  }
+
+  // objects
+  const json& objs = rd.field(root, "", "objects");
+  if (!objs.is_array()) ctx.fail("objects", std::string("expected an array, got ") + type_name(objs));
+  if (objs.empty()) ctx.fail("objects", "the scene has no objects");
+  for (std::size_t i = 0; i < objs.size(); ++i)
+    read_object(rd, objs[i], "objects[" + std::to_string(i) + "]", out.world, ids, override_strategy);
+
+  // Self-intersection guard proportional to the scene's coordinates: a few
+  // thousand float ulps of the largest coordinate (1.1e-3 for the 555-unit
+  // Cornell box, Shirley's 0.001).
+  float extent = 1.0f;
+  auto grow = [&](vec3 p) { extent = std::max({extent, std::abs(p.x), std::abs(p.y), std::abs(p.z)}); };
+  auto grow_axis = [&](const auto& v) {
+    for (const auto& o : v) grow(o.shape.to_rect().corner), grow(o.shape.to_rect().corner + o.shape.to_rect().e1 + o.shape.to_rect().e2);
+  };
+  grow_axis(std::get<std::vector<object<yz_rect_shape>>>(out.world.objects));
+  grow_axis(std::get<std::vector<object<xz_rect_shape>>>(out.world.objects));
+  grow_axis(std::get<std::vector<object<xy_rect_shape>>>(out.world.objects));
+  for (const auto& o : std::get<std::vector<object<rect>>>(out.world.objects)) grow(o.shape.corner), grow(o.shape.corner + o.shape.e1 + o.shape.e2);
+  for (const auto& o : std::get<std::vector<object<ellipse>>>(out.world.objects)) grow(o.shape.center);
+  for (const auto& o : std::get<std::vector<object<sphere>>>(out.world.objects)) grow(o.shape.center);
+  for (const auto& o : std::get<std::vector<object<box>>>(out.world.objects)) grow(o.shape.xf.to_world(o.shape.hi));
+  out.world.ray_epsilon = 2e-6f * extent;
+  return out;
+}
+
+}  // namespace mcrt::cli

@@ -1,0 +1,39 @@
+#pragma once
+// Reads a scene file (shared/spec scene-format contract) into an mcrt::scene.
+// Every violation of the contract throws input_error with one line naming
+// the file, the place in it and what is wrong.
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "mcrt/mcrt.hpp"
+
+namespace mcrt::cli {
+
+// Bad input (command line or scene): reported as one line, exit status 2.
+struct input_error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Documented limits of what a scene or the command line may ask for.
+inline constexpr int max_resolution = 16384;    // pixels per side
+inline constexpr int max_spp = 1 << 20;          // samples per pixel
+inline constexpr int max_depth_limit = 100000;   // scattering events
+
+struct camera_desc {
+  vec3 lookfrom{278.0f, 278.0f, -800.0f}, lookat{278.0f, 278.0f, 0.0f}, vup{0.0f, 1.0f, 0.0f};
+  float vfov = 40.0f;
+  int width = 600, height = 600;
+};
+
+struct loaded_scene {
+  std::string name;  // file name without directory and extension
+  scene world;
+  camera_desc cam;
+  int spp = 100, max_depth = 50;
+};
+
+// override_strategy: --light-sampling; switches every light to one strategy.
+loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy = std::nullopt);
+
+}  // namespace mcrt::cli
