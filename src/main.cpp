@@ -180,6 +180,10 @@ int main(int argc, char** argv) {
   diff_cmd->add_option("reference", dop.reference, "Reference image")->required();
   diff_cmd->add_flag("--json", dop.json, "Print one JSON object");
 
+  if (argc > 1 && argv[1][0] != '-' && std::string(argv[1]) != "render" && std::string(argv[1]) != "diff") {
+    std::fprintf(stderr, "mcrt: unknown command '%s' (expected render or diff; see mcrt --help)\n", argv[1]);
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -34,6 +34,41 @@ const char* type_name(const json& j) {
   }
 }
 
+// Stands in for a number literal too large for a double (JSON has no
+// infinity, but 1e999 is valid JSON text), so that the place is reported.
+constexpr const char* overflow_marker = "<mcrt: number overflows a double>";
+
+// Parses JSON text; number literals that overflow a double are replaced by
+// overflow_marker, so the reader can name where they are.
+json parse_json(std::string text, const context& ctx) {
+  for (int attempt = 0; attempt < 10000; ++attempt) {
+    try {
+      return json::parse(text);
+    } catch (const json::parse_error& e) {
+      std::string what = e.what();
+      // "[json.exception.parse_error.101] parse error at line 3, column 5: ..." -> keep the readable part.
+      if (const auto p = what.find("parse error"); p != std::string::npos) what = what.substr(p);
+      ctx.fail("", "invalid JSON: " + what);
+    } catch (const json::out_of_range& e) {
+      // "number overflow parsing '1e999'": replace that literal wherever it
+      // stands as a whole number token, then parse again.
+      const std::string what = e.what();
+      const auto a = what.find('\''), b = what.rfind('\'');
+      if (e.id != 406 || a == std::string::npos || b <= a + 1) ctx.fail("", std::string("invalid JSON: ") + e.what());
+      const std::string token = what.substr(a + 1, b - a - 1);
+      const auto is_num = [](char c) { return std::isdigit(static_cast<unsigned char>(c)) || c == '.' || c == 'e' || c == 'E' || c == '+' || c == '-'; };
+      bool replaced = false;
+      for (std::size_t p = text.find(token); p != std::string::npos; p = text.find(token, p + 1)) {
+        if ((p > 0 && is_num(text[p - 1])) || (p + token.size() < text.size() && is_num(text[p + token.size()]))) continue;
+        text.replace(p, token.size(), "\"" + std::string(overflow_marker) + "\"");
+        replaced = true;
+      }
+      if (!replaced) ctx.fail("", std::string("invalid JSON: ") + e.what());
+    }
+  }
+  ctx.fail("", "invalid JSON: too many overflowing numbers");
+}
+
 // Accessors that check presence, type and finiteness.
 struct reader {
   const context& ctx;
@@ -44,6 +79,7 @@ struct reader {
     return *it;
   }
   double number(const json& j, const std::string& place) const {
+    if (j.is_string() && j.get<std::string>() == overflow_marker) ctx.fail(place, "number is not finite (overflows a double)");
     if (!j.is_number()) ctx.fail(place, std::string("expected a number, got ") + type_name(j));
     const double v = j.get<double>();
     if (!std::isfinite(v)) ctx.fail(place, "number is not finite");
@@ -275,15 +311,9 @@ loaded_scene load_scene(const std::string& path, std::optional<light_sampling> o
   std::ifstream in(path, std::ios::binary);
   if (!in) ctx.fail("", "cannot open the scene file");
   if (std::filesystem::is_directory(path)) ctx.fail("", "is a directory, not a scene file");
-  json root;
-  try {
-    root = json::parse(in);
-  } catch (const json::parse_error& e) {
-    std::string what = e.what();
-    // "[json.exception.parse_error.101] parse error at line 3, column 5: ..." -> keep the readable part.
-    if (const auto p = what.find("parse error"); p != std::string::npos) what = what.substr(p);
-    ctx.fail("", "invalid JSON: " + what);
-  }
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const json root = parse_json(buffer.str(), ctx);
   if (!root.is_object()) ctx.fail("", std::string("expected a JSON object at the top level, got ") + type_name(root));
   rd.only(root, "", {"camera", "render", "materials", "objects"});
 

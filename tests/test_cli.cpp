@@ -1,0 +1,277 @@
+// The mcrt executable against its contract (shared/spec cli.md and
+// scene-format.md): outputs, stats, diff, determinism across thread counts,
+// and bad input: one line naming the file and the place, exit status 2, no
+// output file created or touched.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct result {
+  int status;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  fs::path dir;
+
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir = fs::temp_directory_path() / ("mcrt_cli_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  void TearDown() override { fs::remove_all(dir); }
+
+  result run(const std::string& args) const {
+    const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
+    const std::string cmd = std::string(MCRT_EXE) + " " + args + " >" + out.string() + " 2>" + err.string() + " </dev/null";
+    const int raw = std::system(cmd.c_str());
+    result r{WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(out), slurp(err)};
+    fs::remove(out);
+    fs::remove(err);
+    return r;
+  }
+
+  fs::path write(const std::string& name, const std::string& text) const {
+    const fs::path p = dir / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p;
+  }
+
+  // A small valid scene with `objects` spliced in.
+  std::string scene_with(const std::string& objects, const std::string& extra_materials = "") const {
+    return R"({
+  "camera": {"lookfrom": [0, 1, -3], "lookat": [0, 0.5, 0], "vup": [0, 1, 0], "vfov": 40, "width": 16, "height": 12},
+  "render": {"spp": 2, "max_depth": 4},
+  "materials": {"white": {"type": "lambertian", "albedo": [0.7, 0.7, 0.7]},
+                "light": {"type": "diffuse_light", "emit": [4, 4, 4]})" +
+           extra_materials + R"(},
+  "objects": [)" + objects + "]}";
+  }
+
+  static std::string good_objects() {
+    return R"({"type": "xz_rect", "x0": -5, "x1": 5, "z0": -5, "z1": 5, "k": 0, "material": "white"},
+              {"type": "xz_rect", "x0": -0.5, "x1": 0.5, "z0": -0.5, "z1": 0.5, "k": 2, "material": "light", "flip": true},
+              {"type": "sphere", "center": [0, 0.5, 0], "radius": 0.5, "material": "white"})";
+  }
+
+  // Runs a failing render and checks the contract for bad input: exit 2,
+  // one line on stderr that contains every `needles`, nothing on stdout, and
+  // the output file (which exists beforehand) left byte for byte as it was.
+  void expect_bad(const std::string& args, std::initializer_list<std::string> needles, const fs::path& out) const {
+    std::ofstream(out, std::ios::binary) << "previous contents";
+    const result r = run(args);
+    EXPECT_EQ(r.status, 2) << args << "\nstderr: " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line expected, got: " << r.err;
+    for (const auto& n : needles) EXPECT_NE(r.err.find(n), std::string::npos) << "'" << n << "' not in: " << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    EXPECT_EQ(slurp(out), "previous contents") << "the output file was touched";
+    for (const auto& e : fs::directory_iterator(out.parent_path()))
+      EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << "temporary left: " << e.path();
+  }
+
+  void expect_bad_scene(const std::string& scene_text, std::initializer_list<std::string> needles) const {
+    const fs::path s = write("bad.json", scene_text), out = dir / "out.exr";
+    std::vector<std::string> all{"bad.json"};
+    all.insert(all.end(), needles.begin(), needles.end());
+    std::ofstream(out) << "previous contents";
+    const result r = run("render " + s.string() + " -o " + out.string() + " --quiet");
+    EXPECT_EQ(r.status, 2) << scene_text << "\nstderr: " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line expected, got: " << r.err;
+    for (const auto& n : all) EXPECT_NE(r.err.find(n), std::string::npos) << "'" << n << "' not in: " << r.err;
+    EXPECT_EQ(slurp(out), "previous contents");
+  }
+};
+
+}  // namespace
+
+TEST_F(Cli, RendersEveryFormatWithStats) {
+  const fs::path s = write("good.json", scene_with(good_objects()));
+  for (const std::string ext : {"exr", "png", "ppm"}) {
+    const fs::path out = dir / ("img." + ext), stats = dir / ("stats_" + ext + ".json");
+    const result r = run("render " + s.string() + " -o " + out.string() + " --stats=" + stats.string() + " --quiet");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(r.err.empty()) << "--quiet: " << r.err;
+    EXPECT_TRUE(r.out.empty()) << "nothing but requested data on stdout: " << r.out;
+    ASSERT_TRUE(fs::exists(out));
+    const auto j = nlohmann::json::parse(slurp(stats));
+    for (const char* key : {"render_seconds", "spp", "width", "height", "threads", "samples_per_second", "light_sampling"})
+      EXPECT_TRUE(j.contains(key)) << key;
+    EXPECT_EQ(j["spp"], 2);
+    EXPECT_EQ(j["width"], 16);
+    EXPECT_EQ(j["height"], 12);
+    EXPECT_EQ(j["light_sampling"], "area");
+    EXPECT_NEAR(j["samples_per_second"].get<double>(), 16.0 * 12 * 2 / j["render_seconds"].get<double>(), 1e-6 * j["samples_per_second"].get<double>());
+  }
+  // EXR header attributes: render time and spp (attribute names are plain text in the header).
+  const std::string exr = slurp(dir / "img.exr");
+  EXPECT_NE(exr.find("mcrt:render_seconds"), std::string::npos);
+  EXPECT_NE(exr.find("mcrt:spp"), std::string::npos);
+  // PPM: Shirley's plain format.
+  EXPECT_EQ(slurp(dir / "img.ppm").rfind("P3\n16 12\n255\n", 0), 0u);
+}
+
+TEST_F(Cli, FlagsOverrideTheScene) {
+  const fs::path s = write("good.json", scene_with(good_objects())), stats = dir / "s.json";
+  const result r = run("render " + s.string() + " -o " + (dir / "o.exr").string() +
+                       " --spp 3 --width=20 --height 10 --max-depth 2 --threads 1 --seed 9 --light-sampling area --stats " +
+                       stats.string() + " --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(slurp(stats));
+  EXPECT_EQ(j["spp"], 3);
+  EXPECT_EQ(j["width"], 20);
+  EXPECT_EQ(j["height"], 10);
+  EXPECT_EQ(j["threads"], 1);
+}
+
+TEST_F(Cli, DefaultOutputIsSceneNameExrInTheWorkingDirectory) {
+  const fs::path s = write("my_scene.json", scene_with(good_objects()));
+  const result r = run("render " + s.string() + " --quiet --spp 1 && mv my_scene.exr " + (dir / "moved.exr").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "moved.exr"));
+}
+
+TEST_F(Cli, ProgressGoesToStderrUnlessQuiet) {
+  const fs::path s = write("good.json", scene_with(good_objects()));
+  const result r = run("render " + s.string() + " -o " + (dir / "o.png").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("100.0%"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty());
+}
+
+TEST_F(Cli, SameSeedSameImageForAnyThreadCountAndDiffReportsZero) {
+  const fs::path s = write("good.json", scene_with(good_objects()));
+  const fs::path a = dir / "a.exr", b = dir / "b.exr", c = dir / "c.exr";
+  ASSERT_EQ(run("render " + s.string() + " -o " + a.string() + " --threads 1 --seed 5 --quiet").status, 0);
+  ASSERT_EQ(run("render " + s.string() + " -o " + b.string() + " --threads 2 --seed 5 --quiet").status, 0);
+  ASSERT_EQ(run("render " + s.string() + " -o " + c.string() + " --threads 2 --seed 6 --quiet").status, 0);
+  result r = run("diff " + a.string() + " " + b.string() + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["rmse"].get<double>(), 0.0);
+  EXPECT_EQ(j["mse"].get<double>(), 0.0);
+  EXPECT_EQ(j["relmse"].get<double>(), 0.0);
+  EXPECT_EQ(j["mean_diff_percent"].get<double>(), 0.0);
+  r = run("diff " + a.string() + " " + c.string() + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j["rmse"].get<double>(), 0.0);
+  EXPECT_NEAR(j["rmse"].get<double>() * j["rmse"].get<double>(), j["mse"].get<double>(), 1e-12);
+  r = run("diff " + a.string() + " " + c.string());
+  ASSERT_EQ(r.status, 0);
+  for (const char* key : {"rmse", "mse", "relmse", "mean_diff_percent"}) EXPECT_NE(r.out.find(key), std::string::npos);
+}
+
+TEST_F(Cli, DiffRefusesImagesOfDifferentSize) {
+  const fs::path s = write("good.json", scene_with(good_objects()));
+  const fs::path a = dir / "a.exr", b = dir / "b.exr";
+  ASSERT_EQ(run("render " + s.string() + " -o " + a.string() + " --quiet").status, 0);
+  ASSERT_EQ(run("render " + s.string() + " -o " + b.string() + " --width 8 --quiet").status, 0);
+  const result r = run("diff " + a.string() + " " + b.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("size"), std::string::npos) << r.err;
+  EXPECT_EQ(run("diff " + a.string() + " " + (dir / "missing.exr").string()).status, 2);
+}
+
+TEST_F(Cli, BadCommandLines) {
+  const fs::path s = write("good.json", scene_with(good_objects())), out = dir / "out.exr";
+  const std::string base = "render " + s.string() + " -o " + out.string() + " --quiet ";
+  expect_bad(base + "--spp 0", {"--spp"}, out);
+  expect_bad(base + "--spp -3", {"--spp"}, out);
+  expect_bad(base + "--width 20000", {"--width", "16384"}, out);
+  expect_bad(base + "--threads 0", {"--threads"}, out);
+  expect_bad(base + "--light-sampling sideways", {"--light-sampling"}, out);
+  expect_bad(base + "--no-such-flag", {"no-such-flag"}, out);
+  expect_bad("render " + (dir / "missing.json").string() + " -o " + out.string(), {"missing.json"}, out);
+  expect_bad("frobnicate", {"frobnicate"}, out);
+}
+
+TEST_F(Cli, BadOutputPaths) {
+  const fs::path s = write("good.json", scene_with(good_objects())), out = dir / "out.exr";
+  const std::string base = "render " + s.string() + " --quiet ";
+  expect_bad(base + "-o " + (dir / "out.tiff").string(), {"out.tiff", ".tiff"}, out);
+  expect_bad(base + "-o " + (dir / "no_such_dir" / "x.exr").string(), {"no_such_dir"}, out);
+  expect_bad(base + "-o " + out.string() + " --stats " + (dir / "no_such_dir" / "s.json").string(), {"no_such_dir"}, out);
+  EXPECT_FALSE(fs::exists(dir / "out.tiff"));
+  if (::geteuid() != 0) {  // root may write anywhere
+    fs::create_directories(dir / "ro");
+    fs::permissions(dir / "ro", fs::perms::owner_read | fs::perms::owner_exec);
+    expect_bad(base + "-o " + (dir / "ro" / "x.exr").string(), {"ro"}, out);
+    fs::permissions(dir / "ro", fs::perms::owner_all);
+  }
+}
+
+TEST_F(Cli, BadScenes) {
+  const std::string floor = R"({"type": "xz_rect", "x0": -5, "x1": 5, "z0": -5, "z1": 5, "k": 0, "material": "white"})";
+  expect_bad_scene("{ \"camera\": ", {"invalid JSON"});
+  expect_bad_scene("[1, 2]", {"top level"});
+  expect_bad_scene(scene_with(floor + R"(, {"type": "torus", "material": "white"})"), {"objects[1].type", "torus"});
+  expect_bad_scene(scene_with(floor + R"(, {"type": "sphere", "center": [0, 1, 0], "material": "white"})"),
+                   {"objects[1].radius", "missing"});
+  expect_bad_scene(scene_with(floor + R"(, {"type": "sphere", "center": [0, 1, 0], "radius": "big", "material": "white"})"),
+                   {"objects[1].radius", "number"});
+  expect_bad_scene(scene_with(floor + R"(, {"type": "sphere", "center": [0, 1], "radius": 1, "material": "white"})"),
+                   {"objects[1].center", "3"});
+  expect_bad_scene(scene_with(floor + R"(, {"type": "sphere", "center": [0, 1, 0], "radius": 0, "material": "white"})"),
+                   {"objects[1].radius", "> 0"});
+  expect_bad_scene(scene_with(floor + R"(, {"type": "sphere", "center": [0, 1, 0], "radius": -2, "material": "white"})"),
+                   {"objects[1].radius", "> 0"});
+  expect_bad_scene(scene_with(floor + R"(, {"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "chrome"})"),
+                   {"objects[1].material", "chrome"});
+  expect_bad_scene(scene_with(floor + R"(, {"type": "sphere", "center": [0, 1e999, 0], "radius": 1, "material": "white"})"),
+                   {"objects[1].center", "finite"});
+  expect_bad_scene(scene_with(floor + R"(, {"type": "xz_rect", "x0": 1, "x1": 1, "z0": 0, "z1": 1, "k": 2, "material": "light"})"),
+                   {"objects[1]", "zero-area"});
+  expect_bad_scene(scene_with(floor + R"(, {"type": "ellipse", "center": [0, 2, 0], "axis1": [1, 0, 0], "axis2": [0, 0, 0], "material": "light"})"),
+                   {"objects[1].axis2", "degenerate"});
+  expect_bad_scene(scene_with(floor + R"(, {"type": "rect", "corner": [0, 2, 0], "edge1": [1, 0, 0], "edge2": [1, 0, 1], "material": "light"})"),
+                   {"objects[1]", "orthogonal"});
+  expect_bad_scene(scene_with(floor + R"(, {"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "white", "flipp": true})"),
+                   {"objects[1].flipp", "unknown field"});
+  expect_bad_scene(scene_with(floor, R"(, "odd": {"type": "plasma"})"), {"materials.odd.type", "plasma"});
+  expect_bad_scene(scene_with(floor, R"(, "m": {"type": "metal", "albedo": [1, 1, 1], "fuzz": 2})"), {"materials.m.fuzz"});
+  expect_bad_scene(scene_with(floor, R"(, "g": {"type": "dielectric", "ior": 0})"), {"materials.g.ior"});
+  std::string big = scene_with(floor);
+  big.replace(big.find("\"width\": 16"), 11, "\"width\": 99999");
+  expect_bad_scene(big, {"camera.width", "16384"});
+  std::string zero_spp = scene_with(floor);
+  zero_spp.replace(zero_spp.find("\"spp\": 2"), 8, "\"spp\": 0");
+  expect_bad_scene(zero_spp, {"render.spp"});
+  std::string no_camera = scene_with(floor);
+  no_camera.replace(no_camera.find("\"camera\""), 8, "\"kamera\"");
+  expect_bad_scene(no_camera, {"kamera"});
+}
+
+TEST_F(Cli, EveryShippedSceneRenders) {
+  for (const auto& e : fs::directory_iterator(MCRT_SCENES_DIR)) {
+    if (e.path().extension() != ".json") continue;
+    for (const char* strategy : {"area", "solid-angle"}) {
+      const fs::path out = dir / (e.path().stem().string() + ".exr"), stats = dir / "s.json";
+      const result r = run("render " + e.path().string() + " -o " + out.string() + " --width 24 --height 24 --spp 2 --light-sampling " +
+                           strategy + " --stats " + stats.string() + " --quiet");
+      EXPECT_EQ(r.status, 0) << e.path() << " " << strategy << ": " << r.err;
+      if (r.status == 0) {
+        const auto j = nlohmann::json::parse(slurp(stats));
+        EXPECT_EQ(j["nonfinite_samples"], 0) << e.path();
+      }
+    }
+  }
+}
