@@ -1,0 +1,492 @@
+#pragma once
+// Uniform sampling of the solid angle subtended by an ellipse (or disk):
+// the area-preserving "parallel" (cylindrical) parametrization of the
+// spherical ellipse of Guillen, Urena, King, Fajardo, Georgiev, Lopez-Moreno
+// and Jarabo 2017, "Area-Preserving Parametrizations for Spherical Ellipses"
+// (EGSR 2017), whose area equation Omega_p(phi) = u1 Omega is the paper's
+// eq. 13 (as the seed, app. A.4, numbers it), with the reduction of an arbitrary
+// planar ellipse to a canonical elliptic cone (Heitz 2017, "Analytical
+// calculation of the solid angle subtended by an arbitrarily positioned
+// ellipsoid to a point source", NIMA 2017: eigen-decomposition of the cone's
+// quadratic form).
+//
+// Canonical spherical ellipse. In the cone's principal frame the ellipse
+// is {X^2/a^2 + Y^2/b^2 <= Z^2, Z > 0}: a >= b are the tangents of the
+// spherical semi-axes (alpha = atan a, beta = atan b). Planes through the X
+// axis at angle theta in [-beta, beta] cut it in arcs |X| <= x_max(theta);
+// on the sphere dA = dX dtheta (Archimedes), so the parallel map is
+//   theta from Omega_p(theta) = u1 Omega,  Omega_p(theta) = int_{-beta}^{theta} 2 x_max   (eq. 13)
+//   X uniform on [-x_max(theta), x_max(theta)] by u2
+// Substituting tan(theta) = b sin(psi), psi in [-pi/2, pi/2], the integrand
+// loses its square-root end singularities (the paper's closed form of
+// Omega_p through incomplete elliptic integrals of the 1st and 3rd kinds):
+//   dOmega_p/dpsi = 2 a b cos^2(psi) / ((1 + b^2 sin^2 psi) sqrt(1 + a^2 cos^2 psi + b^2 sin^2 psi))
+//   Omega_p(psi)  = Omega/2 + c1 b J(psi),  c1 = 2 a / sqrt(1 + a^2),  m = (a^2 - b^2)/(1 + a^2)
+//   J(psi)        = int_0^psi cos^2 / ((1 + b^2 sin^2) sqrt(1 - m sin^2))
+// The paper writes J = (1 + p) Pi(-b^2; psi | m) - p F(psi | m) with p = 1/b^2;
+// for small b the two terms are ~1/b^2 and cancel (8 digits lost at b = 1e-4,
+// all of them at b = 1e-8). Carlson's forms of F and Pi (core/carlson.hpp)
+// merge them exactly:
+//   J = s R_F(c^2, D, 1) - ((1 + b^2)/3) s^3 R_J(c^2, D, 1, 1 + b^2 s^2),
+//   D = 1 - m s^2 = (1 + a^2 c^2 + b^2 s^2)/(1 + a^2)  (a sum of positive terms),
+// which loses at most a factor ~b to cancellation (b <= 1e6 here: 1e-10).
+//
+// Two solvers of the area equation Omega_p = u1 Omega are policies:
+//   newton_carlson_solver      closed form above + safeguarded Newton in psi
+//                              (bracket, bisection fallback, planar initial
+//                              guess), residual <= 1e-9 Omega;
+//   bisection_simpson_solver   the seed's method (sec. 4.2, app. A.4): 10
+//                              bisection steps in theta, Omega_p by a
+//                              10-interval composite Simpson rule of 2 h_p.
+//
+// Fallback. Where the spherical map cannot be set up accurately the light
+// is sampled by area (ellipse_area.hpp) and evaluated with the exact area
+// pdf d^2 / (|cos| A). The choice is made by make_ellipse_cone() from the
+// ellipse and the observer only, so sample() and pdf() always agree.
+// Thresholds (see ellipse_cone_limits):
+//   - observer behind or in the plane (float test of ellipse::faces): no
+//     sample, pdf 0, as every one-sided strategy;
+//   - min_height: h / dist < 1e-9, far below the float rounding of the
+//     coordinates (6e-8 relative): the plane of the light is itself
+//     uncertain by more than the observer's height and the spherical
+//     ellipse is thinner than float directions resolve, where area sampling
+//     gives the same directions (grazing observers at 1e-6 use the map);
+//   - max_tangent: b > 1e6 (observer within 1e-6 of a light that fills the
+//     hemisphere, Omega > 2 pi (1 - 1e-6)): J above loses ~b ulps;
+//   - max_ratio: a / b > 1e8: the eigenvalues of the cone's form span
+//     (a/b)^2 > 1/eps_double, so the minor axis is no longer separated from
+//     the rounding of the others; such a sliver is also narrower than the
+//     float resolution of a direction (b < 1e-8 for a < 1), where area
+//     sampling gives the same directions;
+//   - min_omega: Omega < 1e-30 sr: 1/Omega overflows float;
+//   - any non-finite quantity of the set-up.
+#include <array>
+#include <cstdint>
+#include <numbers>
+
+#include "mcrt/core/carlson.hpp"
+#include "mcrt/core/math.hpp"
+#include "mcrt/geometry/ellipse.hpp"
+#include "mcrt/sampling/ellipse_area.hpp"
+#include "mcrt/sampling/light_sample.hpp"
+
+namespace mcrt {
+
+// Canonical spherical ellipse: tangents of the semi-axes, a >= b > 0.
+struct spherical_ellipse {
+  double a = 0.0, b = 0.0;
+};
+
+// A slicing plane of the parallel map, by the sine and cosine of psi in
+// [-pi/2, pi/2] (tan theta = b sin psi, chord half-width on the tangent
+// plane Z = 1: a cos psi). c >= 0.
+struct spherical_ellipse_slice {
+  double s = 0.0, c = 1.0;
+};
+
+// dOmega_p/dpsi (eq. 13's integrand after the substitution tan theta = b sin psi).
+inline double spherical_ellipse_slice_density(const spherical_ellipse& se, spherical_ellipse_slice sl) {
+  const double a2 = se.a * se.a, b2 = se.b * se.b, c2 = sl.c * sl.c, s2 = sl.s * sl.s;
+  return 2.0 * se.a * se.b * c2 / ((1.0 + b2 * s2) * std::sqrt(1.0 + a2 * c2 + b2 * s2));
+}
+
+// Omega_p(psi) - Omega/2 = c1 b J(psi), odd in psi (see the header comment).
+inline double spherical_ellipse_half_partial_area(const spherical_ellipse& se, spherical_ellipse_slice sl) {
+  const double a2 = se.a * se.a, b2 = se.b * se.b, c2 = sl.c * sl.c, s2 = sl.s * sl.s;
+  const double d = (1.0 + a2 * c2 + b2 * s2) / (1.0 + a2);  // 1 - m s^2 without cancellation
+  double rf, rj;
+  carlson_rf_rj(c2, d, 1.0, 1.0 + b2 * s2, rf, rj);
+  const double j = sl.s * (rf - (1.0 + b2) / 3.0 * s2 * rj);
+  return 2.0 * se.a * se.b / std::sqrt(1.0 + a2) * j;
+}
+
+// Solid angle of the canonical spherical ellipse: Omega_p at psi = pi/2
+// (complete integrals).
+inline double spherical_ellipse_area(const spherical_ellipse& se) {
+  return 2.0 * spherical_ellipse_half_partial_area(se, {1.0, 0.0});
+}
+
+// Closed form + safeguarded Newton (the paper's recommendation).
+struct newton_carlson_solver {
+  // Newton stops once |Omega_p(psi) - u1 Omega| <= tolerance * Omega.
+  static constexpr double tolerance = 1e-9;
+  static constexpr int max_iterations = 60;
+
+  static double area(const spherical_ellipse& se) { return spherical_ellipse_area(se); }
+
+  // Omega_p: the solid angle of the part of the spherical ellipse on the
+  // -psi side of the slice.
+  static double partial_area(const spherical_ellipse& se, double omega, spherical_ellipse_slice sl) {
+    return 0.5 * omega + spherical_ellipse_half_partial_area(se, sl);
+  }
+
+  // The slice with Omega_p = u1 Omega; `iterations` (optional) reports the
+  // number of area evaluations.
+  static spherical_ellipse_slice invert(const spherical_ellipse& se, double omega, double u1,
+                                        int* iterations = nullptr) {
+    constexpr double half_pi = 0.5 * std::numbers::pi;
+    // Omega_p - Omega/2 is odd in psi: solve for |psi| on [0, pi/2].
+    const double target = (u1 - 0.5) * omega;
+    const double sign = target < 0.0 ? -1.0 : 1.0, goal = std::abs(target), half = 0.5 * omega;
+    if (iterations) *iterations = 0;
+    if (!(goal < half)) return {sign, 0.0};
+    // Initial guess: the same equation for a planar ellipse (a, b -> 0), where
+    // J = (psi + sin psi cos psi)/2 and the area fraction v = goal/half
+    // solves 2 psi + sin 2 psi = pi v. Start from its leading behaviour at
+    // either end (4 psi = pi v; (4/3) (pi/2 - psi)^3 = pi (1 - v)), then two
+    // Newton steps on that cheap equation.
+    const double v = goal / half;
+    double psi = v < 0.5 ? 0.25 * std::numbers::pi * v : half_pi - std::cbrt(0.75 * std::numbers::pi * (1.0 - v));
+    for (int i = 0; i < 2; ++i) {
+      const double c = std::cos(psi);
+      const double fp = 4.0 * c * c;
+      if (!(fp > 1e-12)) break;  // at the end of the interval: keep the end estimate
+      psi = std::clamp(psi - (2.0 * psi + std::sin(2.0 * psi) - std::numbers::pi * v) / fp, 0.0, half_pi);
+    }
+    // Newton on f(psi) = Omega_p(psi) - Omega/2 - goal, increasing on
+    // [0, pi/2]; the bracket [lo, hi] shrinks with the sign of f and a step
+    // leaving it is replaced by bisection (f' -> 0 as cos^2 at the end).
+    double lo = 0.0, hi = half_pi;
+    spherical_ellipse_slice sl{std::sin(psi), std::cos(psi)};
+    for (int it = 1; it <= max_iterations; ++it) {
+      if (iterations) *iterations = it;
+      const double f = spherical_ellipse_half_partial_area(se, sl) - goal;
+      if (std::abs(f) <= tolerance * omega) break;
+      (f < 0.0 ? lo : hi) = psi;
+      const double fp = spherical_ellipse_slice_density(se, sl);
+      double next = psi - f / fp;
+      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+      if (next == psi) break;  // the bracket is down to one ulp
+      psi = next;
+      sl = {std::sin(psi), std::cos(psi)};
+    }
+    return {sign * sl.s, sl.c};
+  }
+};
+
+// The seed's solver (sec. 4.2 and app. A.4): Omega_p(theta) by a composite
+// Simpson rule of the paper's integrand 2 h_p(theta) (eq. 13) with 10
+// intervals on [0, beta] and [0, |theta|], and theta by 10 bisection steps
+// on [-beta, beta]. The integrand has square-root zeros at +-beta, so the
+// rule converges as n^-1.5 and its Omega is low by ~2e-3 relative; pdf() is
+// 1 / that Omega, consistent with sample() but not with the true density.
+// The seed also stopped bisection once the bracket was narrower than 1e-3
+// rad, which for lights under 1e-3 rad collapses every sample onto theta =
+// 0; that absolute tolerance is left out.
+struct bisection_simpson_solver {
+  static constexpr int simpson_intervals = 10;
+  static constexpr int bisection_steps = 10;
+
+  // 2 h_p(theta), h_p = x_max(theta) the chord half-width on the sphere
+  // (eq. 13; seed app. A.4).
+  static double integrand(const spherical_ellipse& se, double theta) {
+    const double a2 = se.a * se.a, b2 = se.b * se.b;
+    const double ct = se.a / std::sqrt(1.0 + a2), p = 1.0 / b2, m = (a2 - b2) / (a2 + 1.0);
+    const double sp = sqr(std::sin(theta));
+    const double disc = (1.0 - (p + 1.0) * sp) / (1.0 - (m * p + 1.0) * sp);
+    return 2.0 * ct * safe_sqrt(disc);  // disc rounds below 0 at theta = +-beta
+  }
+  static double simpson(const spherical_ellipse& se, double t0, double t1) {
+    const int n = simpson_intervals;
+    const double step = (t1 - t0) / n;
+    double s1 = 0.0, s2 = 0.0;
+    for (int i = 0; i < n; ++i) s1 += integrand(se, t0 + step * (i + 0.5));
+    for (int i = 1; i < n; ++i) s2 += integrand(se, t0 + step * i);
+    return step / 6.0 * (integrand(se, t0) + integrand(se, t1) + 4.0 * s1 + 2.0 * s2);
+  }
+  static double beta(const spherical_ellipse& se) { return std::atan(se.b); }
+  static double partial_area_theta(const spherical_ellipse& se, double theta) {
+    const double whole = simpson(se, 0.0, beta(se)), part = simpson(se, 0.0, std::abs(theta));
+    return theta >= 0.0 ? whole + part : whole - part;
+  }
+
+  static double area(const spherical_ellipse& se) { return 2.0 * simpson(se, 0.0, beta(se)); }
+  static double partial_area(const spherical_ellipse& se, double, spherical_ellipse_slice sl) {
+    return partial_area_theta(se, std::atan(se.b * sl.s));
+  }
+  static spherical_ellipse_slice invert(const spherical_ellipse& se, double omega, double u1,
+                                        int* iterations = nullptr) {
+    double lo = -beta(se), hi = beta(se), mid = 0.0;
+    const double goal = u1 * omega;
+    for (int i = 0; i < bisection_steps; ++i) {
+      mid = 0.5 * (lo + hi);
+      (partial_area_theta(se, mid) < goal ? lo : hi) = mid;
+    }
+    if (iterations) *iterations = bisection_steps;
+    const double s = std::clamp(std::tan(mid) / se.b, -1.0, 1.0);
+    return {s, safe_sqrt(1.0 - s * s)};  // |s| <= 1 after the clamp; the guard is for rounding
+  }
+};
+
+// --- the parallel map on the canonical spherical ellipse. Directions are
+// returned as points (x, y) of the tangent plane Z = 1 of the cone frame,
+// i.e. the direction normalize(x, y, 1), which keeps relative precision for
+// spherical ellipses of any size.
+
+// u in [0,1]^2 -> tangent-plane point (X uniform on the chord).
+template <class Solver = newton_carlson_solver>
+inline dvec2 square_to_spherical_ellipse(dvec2 u, const spherical_ellipse& se, double omega) {
+  const spherical_ellipse_slice sl = Solver::invert(se, omega, u.x);
+  const double w = 2.0 * u.y - 1.0;
+  // On the sphere the chord spans |X| <= a c / L, L^2 = 1 + a^2 c^2 + b^2 s^2, in
+  // the plane through (0, b s, 1); X = w a c / L mapped back to Z = 1:
+  // x = X / Z = w a c sqrt(K / (K + (1 - w^2) a^2 c^2)), K = 1 + b^2 s^2.
+  const double k = 1.0 + sqr(se.b * sl.s), ac = se.a * sl.c;
+  const double x = w * ac * std::sqrt(k / (k + (1.0 - w * w) * ac * ac));
+  return {x, se.b * sl.s};
+}
+// Density per unit SOLID ANGLE: 1 / Omega on the spherical ellipse.
+inline double square_to_spherical_ellipse_pdf(double omega) { return 1.0 / omega; }
+// Tangent-plane point (inside the ellipse) -> u in [0,1]^2.
+template <class Solver = newton_carlson_solver>
+inline dvec2 spherical_ellipse_to_square(dvec2 p, const spherical_ellipse& se, double omega) {
+  const double s = std::clamp(p.y / se.b, -1.0, 1.0);
+  const spherical_ellipse_slice sl{s, safe_sqrt(1.0 - s * s)};  // |s| <= 1; guard for rounding
+  const double u1 = Solver::partial_area(se, omega, sl) / omega;
+  const double k = 1.0 + sqr(se.b * s), ac = se.a * sl.c;
+  // Inverse of x = w a c sqrt(K / (K + (1 - w^2) a^2 c^2)).
+  const double w = ac > 0.0 ? p.x / ac * std::sqrt((k + ac * ac) / (k + p.x * p.x)) : 0.0;
+  return {std::clamp(u1, 0.0, 1.0), std::clamp(0.5 * (w + 1.0), 0.0, 1.0)};
+}
+
+// --- an ellipse seen from an observer as a canonical elliptic cone.
+
+struct ellipse_cone_limits {
+  static constexpr double min_height = 1e-9;   // h / dist
+  static constexpr double max_tangent = 1e6;   // b
+  static constexpr double max_ratio = 1e8;     // a / b
+  static constexpr double min_omega = 1e-30;   // sr
+};
+
+enum class ellipse_cone_mode : std::uint8_t { none, spherical, area };
+
+struct ellipse_cone {
+  ellipse_cone_mode mode = ellipse_cone_mode::none;
+  spherical_ellipse se;
+  double omega = 0.0;
+  // Frame around the direction to the ellipse centre (world space).
+  dvec3 t1{0.0}, t2{0.0}, cdir{0.0};
+  // Cone frame in (t1, t2, cdir) coordinates: X (major), Y (minor), axis.
+  dvec3 ex{0.0}, ey{0.0}, ez{0.0};
+  // Tangent-plane -> ellipse coordinates: a direction v (frame coordinates)
+  // hits the ellipse at centre + xi a1 + eta a2 with
+  // (xi, eta) = R v.xy / (v.z - k . v.xy), R = B^-1 (paper-independent:
+  // inverse of the linear map (xi, eta, 1) -> (xi a1 + eta a2 + d) / dist).
+  double r00 = 0.0, r01 = 0.0, r10 = 0.0, r11 = 0.0;
+  dvec2 k{0.0};
+  dvec3 d{0.0};  // centre - observer
+  double dist = 0.0;
+
+  // Cone frame -> world direction (not normalised).
+  dvec3 to_world(const dvec3& p) const {
+    const dvec3 f = p.x * ex + p.y * ey + p.z * ez;
+    return f.x * t1 + f.y * t2 + f.z * cdir;
+  }
+  dvec3 to_cone(const dvec3& w) const {
+    const dvec3 f{glm::dot(w, t1), glm::dot(w, t2), glm::dot(w, cdir)};
+    return {glm::dot(f, ex), glm::dot(f, ey), glm::dot(f, ez)};
+  }
+  // Ellipse coordinates (xi, eta) of the tangent-plane point p.
+  dvec2 ellipse_coords(dvec2 p) const {
+    const dvec3 f = p.x * ex + p.y * ey + ez;
+    const dvec2 q{r00 * f.x + r01 * f.y, r10 * f.x + r11 * f.y};
+    const double z = f.z - (k.x * f.x + k.y * f.y);
+    return q / z;
+  }
+};
+
+namespace detail {
+
+// Duff et al. 2017 orthonormal basis, in double.
+inline void onb_double(const dvec3& n, dvec3& u, dvec3& v) {
+  const double sign = std::copysign(1.0, n.z);
+  const double a = -1.0 / (sign + n.z);
+  const double b = n.x * n.y * a;
+  u = dvec3(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+  v = dvec3(b, sign + n.y * n.y * a, -n.y);
+}
+
+// Cyclic Jacobi eigen-decomposition of a symmetric 3x3 matrix (Golub & Van
+// Loan, "Matrix Computations", alg. 8.5.3): plain rotations, accurate
+// eigenvectors even for the strongly graded matrices of thin or tiny cones
+// (entries from 1e-16 to 1 side by side), where the closed-form cubic loses
+// the small roots. A rotation is skipped once its off-diagonal entry is
+// below 1e-18 of the geometric mean of the two diagonal entries (relative,
+// not absolute, convergence). Columns of v are the eigenvectors.
+inline void jacobi_eigen3(std::array<std::array<double, 3>, 3>& m, std::array<std::array<double, 3>, 3>& v) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) v[i][j] = i == j ? 1.0 : 0.0;
+  for (int sweep = 0; sweep < 12; ++sweep) {
+    bool rotated = false;
+    for (int p = 0; p < 2; ++p) {
+      for (int q = p + 1; q < 3; ++q) {
+        const double apq = m[p][q];
+        if (std::abs(apq) <= 1e-18 * std::sqrt(std::abs(m[p][p] * m[q][q])) || apq == 0.0) continue;
+        rotated = true;
+        const double theta = (m[q][q] - m[p][p]) / (2.0 * apq);
+        // t = tan of the rotation angle, the smaller root (|angle| <= pi/4);
+        // 1/(2 theta) when theta^2 would overflow.
+        const double t = std::abs(theta) > 1e150
+                             ? 0.5 / theta
+                             : std::copysign(1.0, theta) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
+        const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
+        m[p][p] -= t * apq;
+        m[q][q] += t * apq;
+        m[p][q] = m[q][p] = 0.0;
+        const int r = 3 - p - q;
+        const double mrp = m[r][p], mrq = m[r][q];
+        m[r][p] = m[p][r] = c * mrp - s * mrq;
+        m[r][q] = m[q][r] = s * mrp + c * mrq;
+        for (int i = 0; i < 3; ++i) {
+          const double vip = v[i][p], viq = v[i][q];
+          v[i][p] = c * vip - s * viq;
+          v[i][q] = s * vip + c * viq;
+        }
+      }
+    }
+    if (!rotated) break;
+  }
+}
+
+}  // namespace detail
+
+// The cone of directions from o through the ellipse e, reduced to a
+// canonical spherical ellipse; mode says how the light is sampled from o.
+template <class Solver = newton_carlson_solver>
+inline ellipse_cone make_ellipse_cone(const ellipse& e, const vec3& o) {
+  ellipse_cone cone;
+  if (!e.faces(o)) return cone;  // mode none: behind or in the plane (the float test every sampler uses)
+  cone.mode = ellipse_cone_mode::area;
+  const dvec3 od(o), cd(e.center), a1(e.a1), a2(e.a2), n(e.n);
+  cone.d = cd - od;
+  cone.dist = glm::length(cone.d);
+  const double h = glm::dot(od - cd, n);
+  if (!(h > ellipse_cone_limits::min_height * cone.dist) || !std::isfinite(cone.dist)) return cone;
+  cone.cdir = cone.d / cone.dist;
+  detail::onb_double(cone.cdir, cone.t1, cone.t2);
+
+  // Axes in units of the distance, in the (t1, t2, cdir) frame.
+  const dvec3 u1 = a1 / cone.dist, u2 = a2 / cone.dist;
+  const double b00 = glm::dot(u1, cone.t1), b01 = glm::dot(u2, cone.t1);
+  const double b10 = glm::dot(u1, cone.t2), b11 = glm::dot(u2, cone.t2);
+  const dvec2 g{glm::dot(u1, cone.cdir), glm::dot(u2, cone.cdir)};
+  // det B = (u1 x u2) . cdir = -(|a1 x a2| / dist^2) (h / dist) (n . n_geo):
+  // from the height h, not from b00 b11 - b01 b10, which cancels for grazing
+  // observers.
+  const dvec3 cr = glm::cross(a1, a2);
+  const double det = -glm::length(cr) / (cone.dist * cone.dist) * (h / cone.dist) *
+                     (glm::dot(cr, n) > 0.0 ? 1.0 : -1.0);
+  cone.r00 = b11 / det;
+  cone.r01 = -b01 / det;
+  cone.r10 = -b10 / det;
+  cone.r11 = b00 / det;
+  cone.k = {cone.r00 * g.x + cone.r10 * g.y, cone.r01 * g.x + cone.r11 * g.y};  // R^T g
+  // The cone is {v : v^T Q v <= 0}, Q = M^-T J M^-1 with M = [[B, 0], [g^T, 1]]
+  // (columns: a1, a2, centre, all over dist, in this frame) and J =
+  // diag(1, 1, -1) (Heitz 2017's cone matrix, in another frame). Q's entries are
+  // ~1/b^2 and its small eigenvalue ~1/a^2 drowns in their rounding for
+  // elongated cones (a/b = 1e6: 1e-4 relative). Its inverse
+  //   P = Q^-1 = M J M^T = [[B B^T, B g], [g^T B^T, |g|^2 - 1]]
+  // has the same eigenvectors, eigenvalues p = 1/lambda, entries of the size
+  // of the cone and no inverse in it; Jacobi gets its two eigenvalues of
+  // largest magnitude and all three eigenvectors to full accuracy. The
+  // eigenvalue of smallest magnitude (b^2 when the cone is thin, the axis
+  // one when it is wide) is then taken from det P = -(det B)^2, known from h.
+  std::array<std::array<double, 3>, 3> pm{}, vec{};
+  pm[0][0] = b00 * b00 + b01 * b01;
+  pm[1][1] = b10 * b10 + b11 * b11;
+  pm[0][1] = pm[1][0] = b00 * b10 + b01 * b11;
+  pm[0][2] = pm[2][0] = b00 * g.x + b01 * g.y;
+  pm[1][2] = pm[2][1] = b10 * g.x + b11 * g.y;
+  pm[2][2] = g.x * g.x + g.y * g.y - 1.0;
+  for (const auto& row : pm)
+    for (double x : row)
+      if (!std::isfinite(x)) return cone;
+  detail::jacobi_eigen3(pm, vec);
+  std::array<double, 3> ev{pm[0][0], pm[1][1], pm[2][2]};
+  int ismall = 0;
+  for (int i = 1; i < 3; ++i)
+    if (std::abs(ev[i]) < std::abs(ev[ismall])) ismall = i;
+  ev[ismall] = -(det * det) / (ev[(ismall + 1) % 3] * ev[(ismall + 2) % 3]);
+  // One negative eigenvalue (the axis) and two positive ones: a^2 = -p_a / p_neg.
+  int in = 0;
+  for (int i = 1; i < 3; ++i)
+    if (ev[i] < ev[in]) in = i;
+  const int i1 = (in + 1) % 3, i2 = (in + 2) % 3;
+  const int imaj = ev[i1] >= ev[i2] ? i1 : i2, imin = imaj == i1 ? i2 : i1;
+  const double pneg = ev[in], pmaj = ev[imaj], pmin = ev[imin];
+  if (!(pneg < 0.0 && pmin > 0.0)) return cone;
+  cone.se.a = std::sqrt(-pmaj / pneg);
+  cone.se.b = std::sqrt(-pmin / pneg);
+  auto column = [&](int j) { return dvec3(vec[0][j], vec[1][j], vec[2][j]); };
+  cone.ez = column(in);
+  if (cone.ez.z < 0.0) cone.ez = -cone.ez;  // the nappe that contains the centre direction
+  cone.ex = column(imaj);
+  cone.ey = glm::cross(cone.ez, cone.ex);
+  if (!(cone.se.b <= ellipse_cone_limits::max_tangent) ||
+      !(cone.se.a <= ellipse_cone_limits::max_ratio * cone.se.b))
+    return cone;
+  cone.omega = Solver::area(cone.se);
+  if (!(cone.omega >= ellipse_cone_limits::min_omega) || !std::isfinite(cone.omega)) return cone;
+  cone.mode = ellipse_cone_mode::spherical;
+  return cone;
+}
+
+// Light-sampling strategy: uniform in the solid angle of the ellipse from o
+// (one-sided: nothing behind), through the parallel map of the spherical
+// ellipse; area sampling with its exact pdf where the map is unreliable.
+template <class Solver = newton_carlson_solver>
+struct basic_ellipse_solid_angle_sampler {
+  ellipse shape;
+
+  bool faces(const vec3& o) const { return shape.faces(o); }
+
+  bool sample(const vec3& o, vec2 u, light_sample& s) const {
+    const ellipse_cone cone = make_ellipse_cone<Solver>(shape, o);
+    if (cone.mode == ellipse_cone_mode::none) return false;
+    if (cone.mode == ellipse_cone_mode::area) return ellipse_area_sampler{shape}.sample(o, u, s);
+    const dvec2 p = square_to_spherical_ellipse<Solver>(dvec2(u), cone.se, cone.omega);
+    dvec2 xe = cone.ellipse_coords(p);
+    // The map lands inside the ellipse; rounding may leave it ~1e-12 out.
+    const double r2 = glm::dot(xe, xe);
+    if (r2 > 1.0) xe /= std::sqrt(r2);
+    const dvec3 v = cone.d + xe.x * dvec3(shape.a1) + xe.y * dvec3(shape.a2);
+    const double len = glm::length(v);
+    s.dir = vec3(v / len);
+    s.dist = static_cast<float>(len);
+    s.pdf = static_cast<float>(square_to_spherical_ellipse_pdf(cone.omega));
+    return std::isfinite(s.pdf) && s.pdf > 0.0f && all_finite(s.dir);
+  }
+
+  // Density per unit SOLID ANGLE at o of the unit direction dir.
+  float pdf(const vec3& o, const vec3& dir) const {
+    const ellipse_cone cone = make_ellipse_cone<Solver>(shape, o);
+    if (cone.mode == ellipse_cone_mode::none) return 0.0f;
+    if (cone.mode == ellipse_cone_mode::area) return ellipse_area_sampler{shape}.pdf(o, dir);
+    float t;
+    if (!shape.intersect({o, dir}, 0.0f, infinity, t)) return 0.0f;
+    return static_cast<float>(square_to_spherical_ellipse_pdf(cone.omega));
+  }
+
+  // The u that sample() maps to dir (dir must hit the ellipse); false where
+  // sample() has no sample for o.
+  bool invert(const vec3& o, const vec3& dir, vec2& u) const {
+    const ellipse_cone cone = make_ellipse_cone<Solver>(shape, o);
+    if (cone.mode == ellipse_cone_mode::none) return false;
+    if (cone.mode == ellipse_cone_mode::area) {
+      float t;
+      if (!shape.intersect({o, dir}, 0.0f, infinity, t)) return false;
+      u = ellipse_to_square(o + t * dir, shape);
+      return true;
+    }
+    const dvec3 p = cone.to_cone(dvec3(dir));
+    if (!(p.z > 0.0)) return false;
+    u = vec2(spherical_ellipse_to_square<Solver>({p.x / p.z, p.y / p.z}, cone.se, cone.omega));
+    return true;
+  }
+};
+
+using ellipse_solid_angle_sampler = basic_ellipse_solid_angle_sampler<>;
+using ellipse_solid_angle_sampler_bisection_simpson = basic_ellipse_solid_angle_sampler<bisection_simpson_solver>;
+
+}  // namespace mcrt
