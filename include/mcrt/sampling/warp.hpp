@@ -46,8 +46,12 @@ inline vec3 square_to_uniform_cone(vec2 u, float one_minus_cos) {
   return {r * std::cos(phi), r * std::sin(phi), z};
 }
 // Density per unit solid angle: 1 / (2 pi (1 - cos theta_max)) inside the cone.
+// 1 - cos theta is taken as (x^2 + y^2) / (1 + z) in the upper hemisphere:
+// 1 - z there loses the bits a narrow cone needs (d.z is 1 to within a few
+// ulps), and sampled directions near the rim would get density 0.
 inline float square_to_uniform_cone_pdf(const vec3& d, float one_minus_cos) {
-  return (1.0f - d.z) <= one_minus_cos ? 1.0f / (two_pi * one_minus_cos) : 0.0f;
+  const float omc = d.z > 0.0f ? (d.x * d.x + d.y * d.y) / (1.0f + d.z) : 1.0f - d.z;
+  return omc <= one_minus_cos ? 1.0f / (two_pi * one_minus_cos) : 0.0f;
 }
 inline vec2 uniform_cone_to_square(const vec3& d, float one_minus_cos) {
   float phi = std::atan2(d.y, d.x);
