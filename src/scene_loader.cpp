@@ -364,12 +364,14 @@ loaded_scene load_scene(const std::string& path, std::optional<light_sampling> o
   // Cornell box, Shirley's 0.001).
   float extent = 1.0f;
   auto grow = [&](vec3 p) { extent = std::max({extent, std::abs(p.x), std::abs(p.y), std::abs(p.z)}); };
-  auto grow_axis = [&](const auto& v) {
-    for (const auto& o : v) grow(o.shape.to_rect().corner), grow(o.shape.to_rect().corner + o.shape.to_rect().e1 + o.shape.to_rect().e2);
-  };
-  grow_axis(std::get<std::vector<object<yz_rect_shape>>>(out.world.objects));
-  grow_axis(std::get<std::vector<object<xz_rect_shape>>>(out.world.objects));
-  grow_axis(std::get<std::vector<object<xy_rect_shape>>>(out.world.objects));
+  for (std::size_t i = 0; i < out.world.axis_rects.size(); ++i) {
+    const any_axis_rect& a = out.world.axis_rects[i];
+    vec3 lo, hi;
+    lo[a.axis] = hi[a.axis] = a.k;
+    lo[(a.axis + 1) % 3] = a.a0, hi[(a.axis + 1) % 3] = a.a1;
+    lo[(a.axis + 2) % 3] = a.b0, hi[(a.axis + 2) % 3] = a.b1;
+    grow(lo), grow(hi);
+  }
   for (const auto& o : std::get<std::vector<object<rect>>>(out.world.objects)) grow(o.shape.corner), grow(o.shape.corner + o.shape.e1 + o.shape.e2);
   for (const auto& o : std::get<std::vector<object<ellipse>>>(out.world.objects)) grow(o.shape.center);
   for (const auto& o : std::get<std::vector<object<sphere>>>(out.world.objects)) grow(o.shape.center);

@@ -164,3 +164,47 @@ TEST(Geometry, SceneReturnsClosestHitAndItsMaterial) {
   EXPECT_EQ(rec.material, 0u);
   EXPECT_EQ(sc.object_count(), 2u);
 }
+
+TEST(Geometry, AxisRectSetAgreesWithItsMembers) {
+  // Eleven rectangles (two blocks of lanes, the second partly empty) tested
+  // as a set and one by one: same nearest hit, same record.
+  axis_rect_set set;
+  std::vector<any_axis_rect> all;
+  pcg32 rng(5, 6);
+  for (int i = 0; i < 11; ++i) {
+    const int axis = i % 3;
+    const float a0 = rng.uniform() * 4 - 2, b0 = rng.uniform() * 4 - 2;
+    const any_axis_rect m{axis, a0, a0 + 0.2f + rng.uniform(), b0, b0 + 0.2f + rng.uniform(), rng.uniform() * 4 - 2,
+                          (i % 2) == 1, static_cast<std::uint32_t>(i)};
+    set.add(m);
+    all.push_back(m);
+  }
+  int hits = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const ray r{{rng.uniform() * 6 - 3, rng.uniform() * 6 - 3, rng.uniform() * 6 - 3},
+                square_to_uniform_sphere(rng.uniform2())};
+    float best = infinity;
+    int best_i = -1;
+    for (int j = 0; j < 11; ++j) {
+      const any_axis_rect& m = all[static_cast<std::size_t>(j)];
+      const float t = (m.k - r.o[m.axis]) / r.d[m.axis];
+      const float pu = r.o[(m.axis + 1) % 3] + t * r.d[(m.axis + 1) % 3];
+      const float pv = r.o[(m.axis + 2) % 3] + t * r.d[(m.axis + 2) % 3];
+      if (t > 1e-3f && t < best && pu >= m.a0 && pu <= m.a1 && pv >= m.b0 && pv <= m.b1) best = t, best_i = j;
+    }
+    float t;
+    const any_axis_rect* m = nullptr;
+    const bool hit = set.intersect(r, 1e-3f, infinity, t, m);
+    ASSERT_EQ(hit, best_i >= 0) << i;
+    if (hit) {
+      ++hits;
+      EXPECT_EQ(t, best);
+      EXPECT_EQ(m->material, static_cast<std::uint32_t>(best_i));
+      hit_record rec;
+      m->surface(r, t, rec);
+      EXPECT_EQ(rec.p[m->axis], m->k);
+      EXPECT_EQ(std::abs(rec.n[m->axis]), 1.0f);
+    }
+  }
+  EXPECT_GT(hits, 1000);
+}

@@ -6,6 +6,7 @@
 #include "mcrt/core/ray.hpp"
 #include "mcrt/core/rng.hpp"
 #include "mcrt/geometry/axis_rect.hpp"
+#include "mcrt/geometry/axis_rect_set.hpp"
 #include "mcrt/geometry/box.hpp"
 #include "mcrt/geometry/ellipse.hpp"
 #include "mcrt/geometry/hit_record.hpp"

@@ -35,17 +35,26 @@ struct axis_rect {
     return rect::make(c, ea, eb, flip);  // cross(e_a, e_b) = +e_Axis for the cyclic order
   }
 
-  bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
-    const float t = (k - r.o[Axis]) / r.d[Axis];  // +-inf or NaN when parallel: rejected below
-    if (!(t > tmin && t < tmax)) return false;
+  bool intersect(const ray& r, float tmin, float tmax, float& t) const {
+    t = (k - r.o[Axis]) / r.d[Axis];  // +-inf or NaN when parallel: rejected below
     const float pa = r.o[a] + t * r.d[a], pb = r.o[b] + t * r.d[b];
-    if (pa < a0 || pa > a1 || pb < b0 || pb > b1) return false;
+    // Non-short-circuit '&': one well-predicted branch instead of six.
+    return (t > tmin) & (t < tmax) & (pa >= a0) & (pa <= a1) & (pb >= b0) & (pb <= b1);
+  }
+
+  // The hit record of a hit at t found by intersect().
+  void surface(const ray& r, float t, hit_record& rec) const {
     rec.t = t;
-    rec.p[Axis] = k;
-    rec.p[a] = pa;
-    rec.p[b] = pb;
+    rec.p = r.at(t);
+    rec.p[Axis] = k;  // exactly on the plane
     rec.n = normal();
     rec.front_face = (r.d[Axis] < 0.0f) != flip;
+  }
+
+  bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
+    float t;
+    if (!intersect(r, tmin, tmax, t)) return false;
+    surface(r, t, rec);
     return true;
   }
 };

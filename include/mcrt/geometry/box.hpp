@@ -12,7 +12,7 @@ struct box {
   rigid_y xf{};
   bool flip = false;  // front side inside instead of outside
 
-  bool hit(const ray& world_ray, float tmin, float tmax, hit_record& rec) const {
+  bool intersect(const ray& world_ray, float tmin, float tmax, float& t) const {
     const ray r = xf.to_local(world_ray);
     const vec3 inv = 1.0f / r.d;
     const vec3 ta = (lo - r.o) * inv, tb = (hi - r.o) * inv;
@@ -20,27 +20,42 @@ struct box {
     const float t0 = std::max(std::max(tnear.x, tnear.y), tnear.z);
     const float t1 = std::min(std::min(tfar.x, tfar.y), tfar.z);
     if (!(t0 <= t1)) return false;
-    float t;
-    vec3 tsel;
     if (t0 > tmin && t0 < tmax) {
       t = t0;
-      tsel = tnear;
-    } else if (t1 > tmin && t1 < tmax) {
-      t = t1;
-      tsel = tfar;
-    } else {
-      return false;
+      return true;
     }
-    // Outward normal of the face whose slab gave t.
-    vec3 local_n{0.0f};
-    const int axis = (tsel.x == t) ? 0 : (tsel.y == t) ? 1 : 2;
-    local_n[axis] = r.d[axis] < 0.0f ? 1.0f : -1.0f;
-    if (t == t1 && t != t0) local_n[axis] = -local_n[axis];  // leaving through the far face
+    if (t1 > tmin && t1 < tmax) {
+      t = t1;
+      return true;
+    }
+    return false;
+  }
+
+  // The hit record of a hit at t found by intersect(): the face is the one
+  // whose plane the local hit point is nearest to, relative to the box size.
+  void surface(const ray& world_ray, float t, hit_record& rec) const {
+    const vec3 p = xf.to_local(world_ray.at(t));
+    const vec3 size = hi - lo;
+    const vec3 dlo = glm::abs(p - lo) / size, dhi = glm::abs(p - hi) / size;
+    int axis = 0;
+    float best = infinity, sign = 0.0f;
+    for (int i = 0; i < 3; ++i) {
+      if (dlo[i] < best) best = dlo[i], axis = i, sign = -1.0f;
+      if (dhi[i] < best) best = dhi[i], axis = i, sign = 1.0f;
+    }
+    vec3 local_n(0.0f);
+    local_n[axis] = sign;
     rec.t = t;
     rec.p = world_ray.at(t);
     const vec3 outward = xf.rotate(local_n);
     rec.n = flip ? -outward : outward;
     rec.front_face = glm::dot(world_ray.d, rec.n) < 0.0f;
+  }
+
+  bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
+    float t;
+    if (!intersect(r, tmin, tmax, t)) return false;
+    surface(r, t, rec);
     return true;
   }
 };

@@ -41,13 +41,18 @@ struct ellipse {
     return sqr(glm::dot(q, a1_dual)) + sqr(glm::dot(q, a2_dual)) <= 1.0f;
   }
 
-  bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
-    float t;
-    if (!intersect(r, tmin, tmax, t)) return false;
+  // The hit record of a hit at t found by intersect().
+  void surface(const ray& r, float t, hit_record& rec) const {
     rec.t = t;
     rec.p = r.at(t);
     rec.n = n;
     rec.front_face = glm::dot(r.d, n) < 0.0f;
+  }
+
+  bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
+    float t;
+    if (!intersect(r, tmin, tmax, t)) return false;
+    surface(r, t, rec);
     return true;
   }
 };

@@ -49,13 +49,18 @@ struct rect {
     return a >= 0.0f && a <= 1.0f && b >= 0.0f && b <= 1.0f;
   }
 
-  bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
-    float t;
-    if (!intersect(r, tmin, tmax, t)) return false;
+  // The hit record of a hit at t found by intersect().
+  void surface(const ray& r, float t, hit_record& rec) const {
     rec.t = t;
     rec.p = r.at(t);
     rec.n = n;
     rec.front_face = glm::dot(r.d, n) < 0.0f;
+  }
+
+  bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
+    float t;
+    if (!intersect(r, tmin, tmax, t)) return false;
+    surface(r, t, rec);
     return true;
   }
 };

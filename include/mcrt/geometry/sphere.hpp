@@ -38,14 +38,19 @@ struct sphere {
     return false;
   }
 
-  bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
-    float t;
-    if (!intersect(r, tmin, tmax, t)) return false;
+  // The hit record of a hit at t found by intersect().
+  void surface(const ray& r, float t, hit_record& rec) const {
     rec.t = t;
     rec.p = r.at(t);
     const vec3 outward = (rec.p - center) / radius;
     rec.n = flip ? -outward : outward;
     rec.front_face = glm::dot(r.d, rec.n) < 0.0f;
+  }
+
+  bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
+    float t;
+    if (!intersect(r, tmin, tmax, t)) return false;
+    surface(r, t, rec);
     return true;
   }
 };

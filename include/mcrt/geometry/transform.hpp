@@ -33,11 +33,22 @@ struct transformed {
   Shape shape;
   rigid_y xf;
 
-  bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
-    if (!shape.hit(xf.to_local(r), tmin, tmax, rec)) return false;
-    // A rigid motion keeps t; move point and normal back to the world.
-    rec.p = r.at(rec.t);
+  // A rigid motion keeps t: intersect in the shape's frame.
+  bool intersect(const ray& r, float tmin, float tmax, float& t) const {
+    return shape.intersect(xf.to_local(r), tmin, tmax, t);
+  }
+
+  // The hit record of a hit at t, moved back to the world.
+  void surface(const ray& r, float t, hit_record& rec) const {
+    shape.surface(xf.to_local(r), t, rec);
+    rec.p = r.at(t);
     rec.n = xf.rotate(rec.n);
+  }
+
+  bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
+    float t;
+    if (!intersect(r, tmin, tmax, t)) return false;
+    surface(r, t, rec);
     return true;
   }
 };

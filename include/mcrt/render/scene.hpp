@@ -6,7 +6,7 @@
 #include <tuple>
 #include <vector>
 
-#include "mcrt/geometry/axis_rect.hpp"
+#include "mcrt/geometry/axis_rect_set.hpp"
 #include "mcrt/geometry/box.hpp"
 #include "mcrt/geometry/ellipse.hpp"
 #include "mcrt/geometry/rect.hpp"
@@ -25,6 +25,7 @@ struct object {
 
 template <class... Shapes>
 struct basic_scene {
+  axis_rect_set axis_rects;  // Shirley's xz/xy/yz rectangles, intersected as a set
   std::tuple<std::vector<object<Shapes>>...> objects;
   std::vector<material> materials;
   std::vector<light> lights;
@@ -32,6 +33,11 @@ struct basic_scene {
   // Rays start this far from the surface they leave (self-intersection guard,
   // Shirley's t_min); set from the scene's size by whoever builds it.
   float ray_epsilon = 1e-3f;
+
+  template <int Axis>
+  void add(const axis_rect<Axis>& s, std::uint32_t material_index) {
+    axis_rects.add(s, material_index);
+  }
 
   template <class Shape>
   std::uint32_t add(const Shape& s, std::uint32_t material_index) {
@@ -41,30 +47,57 @@ struct basic_scene {
   }
 
   std::size_t object_count() const {
-    return std::apply([](const auto&... v) { return (v.size() + ... + std::size_t{0}); }, objects);
+    return axis_rects.size() +
+           std::apply([](const auto&... v) { return (v.size() + ... + std::size_t{0}); }, objects);
   }
 
-  // Closest hit in (tmin, tmax).
+  // Closest hit in (tmin, tmax). Every shape type offers intersect() (the
+  // ray parameter only) and surface() (the full record); only the closest
+  // hit pays for its record.
   bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
-    bool any = false;
-    std::apply([&](const auto&... v) { (hit_all(v, r, tmin, tmax, rec, any), ...); }, objects);
-    return any;
+    closest c{tmax};
+    if (!axis_rects.empty()) {
+      const any_axis_rect* m;
+      if (axis_rects.intersect(r, tmin, c.t, c.t, m)) {
+        c.shape = m;
+        c.fill = &fill_record<any_axis_rect>;
+        c.material = m->material;
+      }
+    }
+    std::apply([&](const auto&... v) { (closest_of(v, r, tmin, c), ...); }, objects);
+    if (!c.shape) return false;
+    c.fill(c.shape, r, c.t, rec);
+    rec.material = c.material;
+    return true;
   }
 
  private:
+  struct closest {
+    float t;
+    const void* shape = nullptr;
+    void (*fill)(const void*, const ray&, float, hit_record&) = nullptr;
+    std::uint32_t material = 0;
+  };
+
   template <class Shape>
-  static void hit_all(const std::vector<object<Shape>>& v, const ray& r, float tmin, float& tmax,
-                      hit_record& rec, bool& any) {
+  static void fill_record(const void* s, const ray& r, float t, hit_record& rec) {
+    static_cast<const Shape*>(s)->surface(r, t, rec);
+  }
+
+  template <class Shape>
+  static void closest_of(const std::vector<object<Shape>>& v, const ray& r, float tmin, closest& c) {
     for (const object<Shape>& o : v) {
-      if (o.shape.hit(r, tmin, tmax, rec)) {
-        tmax = rec.t;
-        rec.material = o.material;
-        any = true;
+      float t;
+      if (o.shape.intersect(r, tmin, c.t, t)) {
+        c.t = t;
+        c.shape = &o.shape;
+        c.fill = &fill_record<Shape>;
+        c.material = o.material;
       }
     }
   }
 };
 
-using scene = basic_scene<yz_rect_shape, xz_rect_shape, xy_rect_shape, rect, ellipse, sphere, box>;
+using scene = basic_scene<rect, ellipse, sphere, box>;
 
 }  // namespace mcrt

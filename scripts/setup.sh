@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Installs what mcrt needs on a fresh Debian 12 machine, and nothing that is
+# already there: the compiler and CMake, the libraries (Debian packages) and
+# a Python virtual environment .venv with the study's plotting packages.
+# Safe to run again.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(cmake g++ make pkg-config libglm-dev libopenimageio-dev nlohmann-json3-dev libcli11-dev
+          libgtest-dev libbenchmark-dev libboost-math-dev python3 python3-venv)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}" >&2
+  sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# Python for scripts/ (the error-vs-time study and its plots).
+if [ ! -x .venv/bin/python ] || ! .venv/bin/python -c "import numpy, matplotlib" 2>/dev/null; then
+  echo "setup: creating .venv with scripts/requirements.txt" >&2
+  python3 -m venv .venv
+  .venv/bin/pip install -q --disable-pip-version-check -r scripts/requirements.txt
+fi
