@@ -261,19 +261,9 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
     const auto [u0, u1] = interval(rd, o, path, a0.c_str(), a1.c_str());
     const auto [v0, v1] = interval(rd, o, path, b0.c_str(), b1.c_str());
     const float k = static_cast<float>(rd.number(o, path, "k"));
-    // Intersected as an axis-aligned shape; sampled as the general rectangle.
-    auto add_axis = [&](auto shape) {
-      shape.k = k;
-      shape.flip = flip;
-      world.add(shape, mat);
-      if (sampled) add_light(rd, world, shape.to_rect(), strategy, path);
-    };
-    if (type == "xz_rect")
-      add_axis(xz_rect_shape{v0, v1, u0, u1});  // in-plane axes (z, x)
-    else if (type == "xy_rect")
-      add_axis(xy_rect_shape{u0, u1, v0, v1});  // (x, y)
-    else
-      add_axis(yz_rect_shape{u0, u1, v0, v1});  // (y, z)
+    add(type == "xz_rect"   ? xz_rect(u0, u1, v0, v1, k, flip)
+        : type == "xy_rect" ? xy_rect(u0, u1, v0, v1, k, flip)
+                            : yz_rect(u0, u1, v0, v1, k, flip));
   } else if (type == "rect") {
     rd.only(o, path, {"type", "material", "flip", "sample", "corner", "edge1", "edge2"});
     const vec3 c = rd.vector3(o, path, "corner"), e1 = rd.vector3(o, path, "edge1"), e2 = rd.vector3(o, path, "edge2");

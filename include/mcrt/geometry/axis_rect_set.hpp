@@ -7,6 +7,7 @@
 // box's six rectangles cost one block test instead of six branchy ones.
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "mcrt/geometry/axis_rect.hpp"
@@ -30,6 +31,25 @@ struct any_axis_rect {
     rec.front_face = (r.d[axis] < 0.0f) != flip;
   }
 };
+
+// The rectangle as an axis-aligned one, if its normal is a coordinate axis
+// (then both edges lie along the other two axes).
+inline std::optional<any_axis_rect> as_axis_rect(const rect& r, std::uint32_t material) {
+  for (int axis = 0; axis < 3; ++axis) {
+    const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+    if (r.n[a] != 0.0f || r.n[b] != 0.0f) continue;
+    const vec3 far = r.corner + r.e1 + r.e2;
+    return any_axis_rect{axis,
+                         std::min(r.corner[a], far[a]),
+                         std::max(r.corner[a], far[a]),
+                         std::min(r.corner[b], far[b]),
+                         std::max(r.corner[b], far[b]),
+                         r.corner[axis],
+                         r.n[axis] < 0.0f,
+                         material};
+  }
+  return std::nullopt;
+}
 
 class axis_rect_set {
  public:

@@ -39,6 +39,15 @@ struct basic_scene {
     axis_rects.add(s, material_index);
   }
 
+  // A rectangle whose edges lie along coordinate axes joins the fast
+  // axis-aligned set; any other is kept as a general rectangle.
+  void add(const rect& r, std::uint32_t material_index) {
+    if (auto a = as_axis_rect(r, material_index))
+      axis_rects.add(*a);
+    else
+      std::get<std::vector<object<rect>>>(objects).push_back({r, material_index});
+  }
+
   template <class Shape>
   std::uint32_t add(const Shape& s, std::uint32_t material_index) {
     auto& v = std::get<std::vector<object<Shape>>>(objects);
