@@ -311,8 +311,8 @@ class spherical_rectangle {
       const double r0 = std::sqrt(d2 + y0_ * y0_), r1 = std::sqrt(d2 + y1_ * y1_);
       const double df = h_ * sine_difference(y0_, r0, y1_, r1, d2) / d2;
       double xn = x - f / df;
+      if (std::abs(xn - x) <= 4.0 * DBL_EPSILON * std::abs(x)) return x;  // step below the resolution of x
       if (!(xn > lo && xn < hi)) xn = 0.5 * (lo + hi);  // also catches df = 0 and NaN
-      if (std::abs(xn - x) <= 4.0 * DBL_EPSILON * std::abs(x)) return xn;  // at the resolution of x
       x = xn;
     }
     return x;
