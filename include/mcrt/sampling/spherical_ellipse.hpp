@@ -357,7 +357,11 @@ inline ellipse_cone make_ellipse_cone(const ellipse& e, const vec3& o) {
   ellipse_cone cone;
   if (!e.faces(o)) return cone;  // mode none: behind or in the plane (the float test every sampler uses)
   cone.mode = ellipse_cone_mode::area;
-  const dvec3 od(o), cd(e.center), a1(e.a1), a2(e.a2), n(e.n);
+  const dvec3 od(o), cd(e.center), a1(e.a1), a2(e.a2);
+  // The front normal from a1 x a2 in double: the float e.n is off the
+  // plane by ~1e-8, which would put an error of 1e-8 dist / h in h.
+  const dvec3 cr = glm::cross(a1, a2);
+  const dvec3 n = cr / glm::length(cr) * (glm::dot(cr, dvec3(e.n)) > 0.0 ? 1.0 : -1.0);
   cone.d = cd - od;
   cone.dist = glm::length(cone.d);
   const double h = glm::dot(od - cd, n);
@@ -373,7 +377,6 @@ inline ellipse_cone make_ellipse_cone(const ellipse& e, const vec3& o) {
   // det B = (u1 x u2) . cdir = -(|a1 x a2| / dist^2) (h / dist) (n . n_geo):
   // from the height h, not from b00 b11 - b01 b10, which cancels for grazing
   // observers.
-  const dvec3 cr = glm::cross(a1, a2);
   const double det = -glm::length(cr) / (cone.dist * cone.dist) * (h / cone.dist) *
                      (glm::dot(cr, n) > 0.0 ? 1.0 : -1.0);
   cone.r00 = b11 / det;
