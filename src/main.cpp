@@ -47,8 +47,8 @@ std::string strategy_summary(const scene& world) {
           using S = std::decay_t<decltype(s)>;
           if constexpr (std::is_same_v<S, rect_area_sampler> || std::is_same_v<S, ellipse_area_sampler>)
             area = true;
-          else if constexpr (!std::is_same_v<S, sphere_cone_sampler>)  // spheres have one strategy only
-            sa = true;
+          else if constexpr (std::is_same_v<S, rect_solid_angle_sampler> || std::is_same_v<S, ellipse_solid_angle_sampler>)
+            sa = true;  // spheres have one strategy only and do not count
         },
         l);
   }

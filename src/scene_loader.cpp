@@ -200,31 +200,22 @@ std::pair<float, float> interval(const reader& rd, const json& o, const std::str
   return {a, b};
 }
 
-struct shape_strategy {
-  bool solid_angle = false;
-};
-
 // Adds the light (or importance target) for a shape, with its strategy.
-template <class Shape>
-void add_light(const reader& rd, scene& world, const Shape& s, light_sampling strategy, const std::string& path) {
-  if constexpr (std::is_same_v<Shape, rect>) {
-    if (strategy == light_sampling::area) {
-      world.lights.emplace_back(rect_area_sampler{s});
-      return;
-    }
-  } else if constexpr (std::is_same_v<Shape, ellipse>) {
-    if (strategy == light_sampling::area) {
-      world.lights.emplace_back(ellipse_area_sampler{s});
-      return;
-    }
-  } else if constexpr (std::is_same_v<Shape, sphere>) {
-    // A sphere is sampled by its cone of directions (solid angle) under
-    // either strategy: there is no area strategy for spheres.
-    world.lights.emplace_back(sphere_cone_sampler{s});
-    return;
-  }
-  rd.ctx.fail(join(path, "type"), "solid-angle sampling of this shape is not available in this build");
+void add_light(scene& world, const rect& s, light_sampling strategy) {
+  if (strategy == light_sampling::area)
+    world.lights.emplace_back(rect_area_sampler{s});
+  else
+    world.lights.emplace_back(rect_solid_angle_sampler{s});
 }
+void add_light(scene& world, const ellipse& s, light_sampling strategy) {
+  if (strategy == light_sampling::area)
+    world.lights.emplace_back(ellipse_area_sampler{s});
+  else
+    world.lights.emplace_back(ellipse_solid_angle_sampler{s});
+}
+// A sphere is sampled by its cone of directions (uniform in solid angle)
+// under either strategy: there is no area strategy for spheres.
+void add_light(scene& world, const sphere& s, light_sampling) { world.lights.emplace_back(sphere_cone_sampler{s}); }
 
 void read_object(const reader& rd, const json& o, const std::string& path, scene& world,
                  const std::map<std::string, std::uint32_t>& material_ids,
@@ -250,7 +241,7 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
 
   auto add = [&](const auto& shape) {
     world.add(shape, mat);
-    if (sampled) add_light(rd, world, shape, strategy, path);
+    if (sampled) add_light(world, shape, strategy);
   };
 
   if (type == "xz_rect" || type == "xy_rect" || type == "yz_rect") {
