@@ -60,23 +60,11 @@ color trace_path(const Scene& sc, ray r, pcg32& rng, const path_settings& ps) {
       const vec3 n = rec.facing_normal();
       const cosine_pdf cos_pdf(n);
       const light_pdf<light> lights(sc.lights, rec.p);
+      const mixture_pdf<light> mix(cos_pdf, lights);
       const float u_select = rng.uniform();
-      const vec2 u = rng.uniform2();
       vec3 dir;
       float p;
-      if (lights.empty()) {
-        dir = cos_pdf.generate(u);
-        p = cos_pdf.value(dir);
-      } else if (u_select < 0.5f) {
-        dir = cos_pdf.generate(u);
-        p = mixture_value(cos_pdf.value(dir), lights.value(dir));
-      } else {
-        light_sample s;
-        const std::ptrdiff_t k = lights.generate(2.0f * u_select - 1.0f, u, s);
-        if (k < 0) break;  // the chosen light had no direction to offer: zero-valued sample
-        dir = s.dir;
-        p = mixture_value(cos_pdf.value(dir), lights.value(dir, k, s.pdf));
-      }
+      if (!mix.generate(u_select, rng.uniform2(), dir, p)) break;  // zero-valued sample
       const float cos_theta = glm::dot(dir, n);
       // Below the surface the scattering pdf is 0: the path carries nothing more.
       if (!(cos_theta > 0.0f) || !(p > 0.0f)) break;

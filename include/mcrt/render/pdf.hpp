@@ -70,9 +70,45 @@ class light_pdf {
   std::size_t count_ = 0;
 };
 
-// Shirley's mixture_pdf with equal weights, as in the book and the seed.
-// Evaluation only; generation is done by choosing one of the two with a
-// random number (see render/path_tracer.hpp).
-inline float mixture_value(float p0, float p1) { return 0.5f * (p0 + p1); }
+// Shirley's mixture_pdf with equal weights, as in the book and the seed:
+// half the directions from the lights, half from the cosine pdf. Where no
+// light faces the point, the cosine pdf alone.
+template <class Light>
+class mixture_pdf {
+ public:
+  mixture_pdf(const cosine_pdf& cos, const light_pdf<Light>& lights) : cos_(cos), lights_(lights) {}
+
+  // Density per unit SOLID ANGLE of the unit direction dir.
+  float value(const vec3& dir) const {
+    return lights_.empty() ? cos_.value(dir) : 0.5f * (cos_.value(dir) + lights_.value(dir));
+  }
+
+  // u_select in [0,1) chooses the component (and, rescaled, the light); u
+  // samples it. Returns false when the chosen light had no direction to
+  // offer (a zero-valued sample). pdf is value(dir), computed without
+  // evaluating the chosen light twice.
+  bool generate(float u_select, vec2 u, vec3& dir, float& pdf) const {
+    if (lights_.empty()) {
+      dir = cos_.generate(u);
+      pdf = cos_.value(dir);
+      return true;
+    }
+    if (u_select < 0.5f) {
+      dir = cos_.generate(u);
+      pdf = 0.5f * (cos_.value(dir) + lights_.value(dir));
+      return true;
+    }
+    light_sample s;
+    const std::ptrdiff_t k = lights_.generate(2.0f * u_select - 1.0f, u, s);
+    if (k < 0) return false;
+    dir = s.dir;
+    pdf = 0.5f * (cos_.value(dir) + lights_.value(dir, k, s.pdf));
+    return true;
+  }
+
+ private:
+  const cosine_pdf& cos_;
+  const light_pdf<Light>& lights_;
+};
 
 }  // namespace mcrt
