@@ -1,6 +1,7 @@
 #pragma once
 // mcrt: a header-only Monte-Carlo path tracer for studying direct sampling
 // of area lights. Include this for everything, or the single headers.
+#include "mcrt/core/dispatch.hpp"
 #include "mcrt/core/math.hpp"
 #include "mcrt/core/onb.hpp"
 #include "mcrt/core/ray.hpp"

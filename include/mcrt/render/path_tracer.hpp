@@ -4,6 +4,7 @@
 // the next direction is drawn from the 50/50 mixture of the lights' pdf and
 // the cosine pdf, and weighted by scattering pdf / mixture pdf; specular
 // materials follow their ray. No heap allocation per bounce.
+#include "mcrt/core/dispatch.hpp"
 #include "mcrt/core/rng.hpp"
 #include "mcrt/render/pdf.hpp"
 #include "mcrt/render/scene.hpp"
@@ -41,8 +42,7 @@ color trace_path(const Scene& sc, ray r, pcg32& rng, const path_settings& ps) {
     }
     if (depth == ps.max_depth) break;
     if (depth >= ps.rr_depth) {
-      const float q = std::visit(
-          [](const auto& mat) {
+      const float q = dispatch(m, [](const auto& mat) {
             using M = std::decay_t<decltype(mat)>;
             if constexpr (std::is_same_v<M, dielectric>)
               return 0.95f;
@@ -50,8 +50,7 @@ color trace_path(const Scene& sc, ray r, pcg32& rng, const path_settings& ps) {
               return 0.0f;
             else
               return survival_probability(mat.albedo);
-          },
-          m);
+          });
       if (!(rng.uniform() < q)) break;
       throughput /= q;
     }
@@ -74,15 +73,13 @@ color trace_path(const Scene& sc, ray r, pcg32& rng, const path_settings& ps) {
     }
 
     specular_scatter sp;
-    const bool scattered = std::visit(
-        [&](const auto& mat) -> bool {
+    const bool scattered = dispatch(m, [&](const auto& mat) -> bool {
           using M = std::decay_t<decltype(mat)>;
           if constexpr (std::is_same_v<M, metal> || std::is_same_v<M, dielectric>)
             return scatter(mat, r, rec, rng, sp);
           else
             return false;
-        },
-        m);
+        });
     if (!scattered) break;
     throughput *= sp.attenuation;
     r = sp.r;

@@ -30,7 +30,7 @@ class cosine_pdf {
 // take no part, so the mixture stays normalised.
 //
 // Light is any type with faces/sample/pdf (see sampling/light_sample.hpp),
-// or a std::variant of such types through the visit in light.hpp.
+// or a std::variant of such types through the dispatch in light.hpp.
 template <class Light>
 class light_pdf {
  public:
