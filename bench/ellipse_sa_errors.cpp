@@ -1,0 +1,76 @@
+// Error table of the two solvers of the spherical ellipse's area equation,
+// per axis ratio and solid-angle decade (markdown on stdout):
+//   residual  max over u of |Omega_p(psi(u)) - u Omega| / Omega, Omega_p and
+//             Omega from the Carlson closed form (exact to ~1e-13);
+//   E[1/pdf]  relative error of E[1/pdf] = the solver's Omega (1/pdf is
+//             constant in the spherical mode) against a Gauss-Kronrod
+//             quadrature of the solid angle over the ellipse.
+// Configurations: an ellipse with semi-axes 1 and 1/ratio seen on its axis
+// from the height that gives the solid angle wanted (bisection on h).
+#include <boost/math/quadrature/gauss_kronrod.hpp>
+#include <cstdio>
+#include <numbers>
+
+#include "mcrt/sampling/spherical_ellipse.hpp"
+
+namespace {
+
+using namespace mcrt;
+
+double omega_quadrature(const ellipse& e, const vec3& o) {
+  const dvec3 od(o), c(e.center), a1(e.a1), a2(e.a2);
+  const dvec3 cr = glm::cross(a1, a2);
+  const double area = glm::length(cr);
+  const dvec3 n = cr / area;
+  using gk = boost::math::quadrature::gauss_kronrod<double, 61>;
+  const auto inner = [&](double phi) {
+    const auto f = [&](double r) {
+      const dvec3 p = c + r * std::cos(phi) * a1 + r * std::sin(phi) * a2 - od;
+      const double d2 = glm::dot(p, p);
+      return r * std::abs(glm::dot(p, n)) / (d2 * std::sqrt(d2));
+    };
+    return gk::integrate(f, 0.0, 1.0, 20, 1e-13);
+  };
+  return area * gk::integrate(inner, 0.0, 2.0 * std::numbers::pi, 20, 1e-13);
+}
+
+template <class Solver>
+double max_residual(const spherical_ellipse& se) {
+  const double omega = spherical_ellipse_area(se), omega_s = Solver::area(se);
+  double worst = 0.0;
+  for (int i = 0; i <= 200; ++i) {
+    const double u = (i + 0.5) / 201.0;
+    const spherical_ellipse_slice sl = Solver::invert(se, omega_s, u);
+    const double r = std::abs(newton_carlson_solver::partial_area(se, omega, sl) - u * omega) / omega;
+    worst = std::max(worst, r);
+  }
+  return worst;
+}
+
+}  // namespace
+
+int main() {
+  const double ratios[] = {1.0, 10.0, 1e2, 1e3, 1e4};
+  const double targets[] = {1e-8, 1e-6, 1e-4, 1e-2, 1.0, 2.0 * std::numbers::pi * (1.0 - 1e-3)};
+  std::printf("| a/b | Omega (sr) | mode | Newton residual | Newton E[1/pdf] err | seed residual | seed E[1/pdf] err |\n");
+  std::printf("|---|---|---|---|---|---|---|\n");
+  for (double ratio : ratios)
+    for (double target : targets) {
+      const ellipse e = ellipse::make({0, 0, 0}, {1, 0, 0}, {0, static_cast<float>(1.0 / ratio), 0});
+      // Omega decreases with h: bisection in log h.
+      double lo = -8.0, hi = 8.0;
+      for (int i = 0; i < 80; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        const ellipse_cone c = make_ellipse_cone(e, vec3(0.0f, 0.0f, static_cast<float>(std::pow(10.0, mid))));
+        (c.omega > target ? lo : hi) = mid;
+      }
+      const vec3 o(0.0f, 0.0f, static_cast<float>(std::pow(10.0, 0.5 * (lo + hi))));
+      const ellipse_cone c = make_ellipse_cone(e, o);
+      const ellipse_cone cs = make_ellipse_cone<bisection_simpson_solver>(e, o);
+      const double ref = omega_quadrature(e, o);
+      std::printf("| %g | %.3g | %s | %.1e | %.1e | %.1e | %.1e |\n", ratio, ref,
+                  c.mode == ellipse_cone_mode::spherical ? "map" : "area", max_residual<newton_carlson_solver>(c.se),
+                  std::abs(c.omega / ref - 1.0), max_residual<bisection_simpson_solver>(c.se),
+                  std::abs(cs.omega / ref - 1.0));
+    }
+}
