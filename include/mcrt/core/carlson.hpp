@@ -26,6 +26,12 @@ namespace mcrt {
 // the 1e-6 accuracy its Newton solver is held to.
 inline constexpr double carlson_tolerance = 1e-12;
 
+// The stopping factors of the duplication loops, evaluated once (std::pow is
+// not constexpr): (3 r)^(-1/6) for R_F and (r/4)^(-1/6) for R_J, r =
+// carlson_tolerance (Carlson 1995, eq. 2.2 and 2.4).
+inline const double carlson_rf_stop = std::pow(3.0 * carlson_tolerance, -1.0 / 6.0);
+inline const double carlson_rj_stop = std::pow(0.25 * carlson_tolerance, -1.0 / 6.0);
+
 // R_C(x, y) = 1/2 int_0^inf (t + x)^(-1/2) (t + y)^(-1) dt, x >= 0, y > 0
 // (DLMF 19.2.17-19.2.18): closed form in atan / atanh; a series near x = y,
 // where both closed forms divide 0 by 0.
@@ -49,8 +55,7 @@ inline double carlson_rc(double x, double y) {
 inline double carlson_rf(double x, double y, double z) {
   const double a0 = (x + y + z) / 3.0, x0 = x, y0 = y;
   double a = a0;
-  // (3 r)^(-1/6) with r = carlson_tolerance
-  const double q = std::pow(3.0 * carlson_tolerance, -1.0 / 6.0) *
+  const double q = carlson_rf_stop *
                    std::max({std::abs(a0 - x), std::abs(a0 - y), std::abs(a0 - z)});
   double scale = 1.0;  // 4^-n
   while (scale * q >= std::abs(a)) {
@@ -75,8 +80,7 @@ inline double carlson_rj(double x, double y, double z, double p) {
   const double a0 = (x + y + z + 2.0 * p) / 5.0, x0 = x, y0 = y, z0 = z;
   double a = a0;
   const double delta = (p - x) * (p - y) * (p - z);
-  // (r/4)^(-1/6) with r = carlson_tolerance
-  const double q = std::pow(0.25 * carlson_tolerance, -1.0 / 6.0) *
+  const double q = carlson_rj_stop *
                    std::max({std::abs(a0 - x), std::abs(a0 - y), std::abs(a0 - z), std::abs(a0 - p)});
   double scale = 1.0;  // 4^-m
   double sum = 0.0;
@@ -112,9 +116,9 @@ inline void carlson_rf_rj(double x, double y, double z, double p, double& rf, do
   const double x0 = x, y0 = y, z0 = z;
   double af = af0, aj = aj0;
   const double delta = (p - x) * (p - y) * (p - z);
-  const double qf = std::pow(3.0 * carlson_tolerance, -1.0 / 6.0) *
+  const double qf = carlson_rf_stop *
                     std::max({std::abs(af0 - x), std::abs(af0 - y), std::abs(af0 - z)});
-  const double qj = std::pow(0.25 * carlson_tolerance, -1.0 / 6.0) *
+  const double qj = carlson_rj_stop *
                     std::max({std::abs(aj0 - x), std::abs(aj0 - y), std::abs(aj0 - z), std::abs(aj0 - p)});
   double scale = 1.0, sum = 0.0;
   while (scale * qf >= std::abs(af) || scale * qj >= std::abs(aj)) {
