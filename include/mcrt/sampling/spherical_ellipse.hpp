@@ -363,10 +363,13 @@ inline void onb_double(const dvec3& n, dvec3& u, dvec3& v) {
 // (entries from 1e-16 to 1 side by side), where the closed-form cubic loses
 // the small roots. A rotation is skipped once its off-diagonal entry is
 // below 1e-18 of the geometric mean of the two diagonal entries (relative,
-// not absolute, convergence). Columns of v are the eigenvectors.
+// not absolute, convergence). Columns of v are the eigenvectors, accumulated
+// only if Vectors (the rotations, hence the eigenvalues, do not depend on it).
+template <bool Vectors = true>
 inline void jacobi_eigen3(std::array<std::array<double, 3>, 3>& m, std::array<std::array<double, 3>, 3>& v) {
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) v[i][j] = i == j ? 1.0 : 0.0;
+  if constexpr (Vectors)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) v[i][j] = i == j ? 1.0 : 0.0;
   for (int sweep = 0; sweep < 12; ++sweep) {
     bool rotated = false;
     for (int p = 0; p < 2; ++p) {
@@ -388,11 +391,12 @@ inline void jacobi_eigen3(std::array<std::array<double, 3>, 3>& m, std::array<st
         const double mrp = m[r][p], mrq = m[r][q];
         m[r][p] = m[p][r] = c * mrp - s * mrq;
         m[r][q] = m[q][r] = s * mrp + c * mrq;
-        for (int i = 0; i < 3; ++i) {
-          const double vip = v[i][p], viq = v[i][q];
-          v[i][p] = c * vip - s * viq;
-          v[i][q] = s * vip + c * viq;
-        }
+        if constexpr (Vectors)
+          for (int i = 0; i < 3; ++i) {
+            const double vip = v[i][p], viq = v[i][q];
+            v[i][p] = c * vip - s * viq;
+            v[i][q] = s * vip + c * viq;
+          }
       }
     }
     if (!rotated) break;
@@ -403,7 +407,10 @@ inline void jacobi_eigen3(std::array<std::array<double, 3>, 3>& m, std::array<st
 
 // The cone of directions from o through the ellipse e, reduced to a
 // canonical spherical ellipse; mode says how the light is sampled from o.
-template <class Solver = newton_carlson_solver>
+// Without Frame only mode, se and omega are set (all that a pdf needs):
+// the same rotations and the same arithmetic, so the same mode and omega,
+// without the eigenvectors and the maps to the ellipse.
+template <class Solver = newton_carlson_solver, bool Frame = true>
 inline ellipse_cone make_ellipse_cone(const ellipse& e, const vec3& o) {
   ellipse_cone cone;
   if (!e.faces(o)) return cone;  // mode none: behind or in the plane (the float test every sampler uses)
@@ -417,24 +424,20 @@ inline ellipse_cone make_ellipse_cone(const ellipse& e, const vec3& o) {
   cone.dist = glm::length(cone.d);
   const double h = glm::dot(od - cd, n);
   if (!(h > ellipse_cone_limits::min_height * cone.dist) || !std::isfinite(cone.dist)) return cone;
-  cone.cdir = cone.d / cone.dist;
-  detail::onb_double(cone.cdir, cone.t1, cone.t2);
+  const dvec3 cdir = cone.d / cone.dist;
+  dvec3 t1, t2;
+  detail::onb_double(cdir, t1, t2);
 
   // Axes in units of the distance, in the (t1, t2, cdir) frame.
   const dvec3 u1 = a1 / cone.dist, u2 = a2 / cone.dist;
-  const double b00 = glm::dot(u1, cone.t1), b01 = glm::dot(u2, cone.t1);
-  const double b10 = glm::dot(u1, cone.t2), b11 = glm::dot(u2, cone.t2);
-  const dvec2 g{glm::dot(u1, cone.cdir), glm::dot(u2, cone.cdir)};
+  const double b00 = glm::dot(u1, t1), b01 = glm::dot(u2, t1);
+  const double b10 = glm::dot(u1, t2), b11 = glm::dot(u2, t2);
+  const dvec2 g{glm::dot(u1, cdir), glm::dot(u2, cdir)};
   // det B = (u1 x u2) . cdir = -(|a1 x a2| / dist^2) (h / dist) (n . n_geo):
   // from the height h, not from b00 b11 - b01 b10, which cancels for grazing
   // observers.
   const double det = -glm::length(cr) / (cone.dist * cone.dist) * (h / cone.dist) *
                      (glm::dot(cr, n) > 0.0 ? 1.0 : -1.0);
-  cone.r00 = b11 / det;
-  cone.r01 = -b01 / det;
-  cone.r10 = -b10 / det;
-  cone.r11 = b00 / det;
-  cone.k = {cone.r00 * g.x + cone.r10 * g.y, cone.r01 * g.x + cone.r11 * g.y};  // R^T g
   // The cone is {v : v^T Q v <= 0}, Q = M^-T J M^-1 with M = [[B, 0], [g^T, 1]]
   // (columns: a1, a2, centre, all over dist, in this frame) and J =
   // diag(1, 1, -1) (Heitz 2017's cone matrix, in another frame). Q's entries are
@@ -456,7 +459,7 @@ inline ellipse_cone make_ellipse_cone(const ellipse& e, const vec3& o) {
   for (const auto& row : pm)
     for (double x : row)
       if (!std::isfinite(x)) return cone;
-  detail::jacobi_eigen3(pm, vec);
+  detail::jacobi_eigen3<Frame>(pm, vec);
   std::array<double, 3> ev{pm[0][0], pm[1][1], pm[2][2]};
   int ismall = 0;
   for (int i = 1; i < 3; ++i)
@@ -472,11 +475,21 @@ inline ellipse_cone make_ellipse_cone(const ellipse& e, const vec3& o) {
   if (!(pneg < 0.0 && pmin > 0.0)) return cone;
   cone.se.a = std::sqrt(-pmaj / pneg);
   cone.se.b = std::sqrt(-pmin / pneg);
-  auto column = [&](int j) { return dvec3(vec[0][j], vec[1][j], vec[2][j]); };
-  cone.ez = column(in);
-  if (cone.ez.z < 0.0) cone.ez = -cone.ez;  // the nappe that contains the centre direction
-  cone.ex = column(imaj);
-  cone.ey = glm::cross(cone.ez, cone.ex);
+  if constexpr (Frame) {
+    cone.cdir = cdir;
+    cone.t1 = t1;
+    cone.t2 = t2;
+    cone.r00 = b11 / det;
+    cone.r01 = -b01 / det;
+    cone.r10 = -b10 / det;
+    cone.r11 = b00 / det;
+    cone.k = {cone.r00 * g.x + cone.r10 * g.y, cone.r01 * g.x + cone.r11 * g.y};  // R^T g
+    auto column = [&](int j) { return dvec3(vec[0][j], vec[1][j], vec[2][j]); };
+    cone.ez = column(in);
+    if (cone.ez.z < 0.0) cone.ez = -cone.ez;  // the nappe that contains the centre direction
+    cone.ex = column(imaj);
+    cone.ey = glm::cross(cone.ez, cone.ex);
+  }
   if (!(cone.se.b <= ellipse_cone_limits::max_tangent) ||
       !(cone.se.a <= ellipse_cone_limits::max_ratio * cone.se.b))
     return cone;
@@ -514,7 +527,7 @@ struct basic_ellipse_solid_angle_sampler {
 
   // Density per unit SOLID ANGLE at o of the unit direction dir.
   float pdf(const vec3& o, const vec3& dir) const {
-    const ellipse_cone cone = make_ellipse_cone<Solver>(shape, o);
+    const ellipse_cone cone = make_ellipse_cone<Solver, false>(shape, o);
     if (cone.mode == ellipse_cone_mode::none) return 0.0f;
     if (cone.mode == ellipse_cone_mode::area) return ellipse_area_sampler{shape}.pdf(o, dir);
     float t;
