@@ -1,9 +1,11 @@
 // The extreme cases of solid-angle rectangle sampling for the README: for
 // each configuration, the exact solid angle S (50-digit Van Oosterom-Strackee,
 // Boost.Multiprecision), the relative error of the estimate E[1/pdf] over
-// 10^6 samples against it with its standard error, the path taken (spherical
-// map, map with Newton polish, or area fallback) and the worst round-trip
-// error |invert(sample(u)) - u| on the map. Prints a markdown table.
+// 10^6 samples against it with its standard error, the path taken by
+// rect_solid_angle_sampler (its fast path, or spherical_rectangle's map, map
+// with Newton polish, or area fallback) and the worst round-trip error
+// |invert(sample(u)) - u| of spherical_rectangle's map. Prints a markdown
+// table.
 #include <boost/multiprecision/cpp_bin_float.hpp>
 #include <cmath>
 #include <cstdio>
@@ -65,6 +67,8 @@ int main() {
   cases.push_back({"aspect 1e4, overhead", strip, {0.0f, 0.0f, 1.0f}});
   cases.push_back({"aspect 1e4, side, grazing 1e-6", strip, {0.0f, -1.5f, 1e-6f}});
   cases.push_back({"aspect 1e4, end-on from 1e5", strip, {1e5f, 0.1f, 300.0f}});
+  cases.push_back({"Cornell light from the floor", xz_rect(213, 343, 227, 332, 554, true), {278.0f, 1.0f, 279.5f}});
+  cases.push_back({"unit square, 45 degrees, 10 sizes", unit, {7.071f, 0.1f, 7.071f}});
 
   constexpr int n = 1'000'000;
   std::printf("| configuration | exact S (sr) | path | rel. error of E[1/pdf] | std. error | max round trip |\n");
@@ -92,7 +96,7 @@ int main() {
       }
     }
     const double mean = sum / n, se = std::sqrt(std::max(sum2 / n - mean * mean, 0.0) / (n - 1));
-    const char* path = !sr.uses_map() ? "area (exact pdf)" : sr.refines() ? "map + Newton" : "map";
+    const char* path = smp.fast_path(c.o) ? "fast map" : !sr.uses_map() ? "area (exact pdf)" : sr.refines() ? "map + Newton" : "map";
     char rts[32] = "-";
     if (sr.uses_map()) std::snprintf(rts, sizeof rts, "%.1e", rt);
     std::printf("| %s | %.6e | %s | %+.1e | %.1e | %s |%s\n", c.name.c_str(), exact, path, mean / exact - 1.0,

@@ -36,7 +36,22 @@
 //    without the division by sin(au), which vanishes where x_u = 0;
 //  * h_1 - h_0 and 1 -+ h_v (sec. 4, second stage) are formed without
 //    subtracting nearly equal numbers (sine_difference, one_minus_sine).
+//
+// Two implementations. spherical_rectangle is exact for every observer in
+// front (down to grazing views at 1e-7 of the light's size, 1e-10 sr, aspect
+// 1e4) at the price of a per-observer set-up with the rectangle cut at the
+// observer's foot, libm's atan2 / sin / cos and Newton polishing.
+// rect_solid_angle_sampler, the strategy the renderer uses, serves the
+// common configurations by a lean version of the same map (its "fast path":
+// no cut, no libm call, square roots packed four at a time, equally exact
+// there) and hands the rest to spherical_rectangle; its comment lists the
+// thresholds.
+#include <array>
 #include <cfloat>
+#include <numbers>
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
 
 #include "mcrt/geometry/rect.hpp"
 #include "mcrt/sampling/light_sample.hpp"
@@ -325,18 +340,273 @@ class spherical_rectangle {
   bool valid_ = false, use_map_ = false, refine_ = false;
 };
 
+namespace spherical_rectangle_detail {
+
+// atan2(y, x) for y >= 0, in [0, pi], to a few ulp of double (relative),
+// without a branch or a libm call: the reductions of Cephes' atan (S. L.
+// Moshier, "Methods and Programs for Mathematical Functions", 1989), t =
+// a / b -> 1/t and t -> (t - 1)/(t + 1) down to |t| <= tan(pi/8), selected
+// by signs (copysign), not by branches, which would be mispredicted from one
+// observer to the next; then atan(t) = t + t z P(z), z = t^2, with P of
+// degree 8 a Chebyshev fit of (atan(t) / t - 1) / z on [0, tan^2(pi/8)]
+// (mpmath.chebyfit, 40 digits; relative error of atan below 5e-15),
+// evaluated by Estrin's scheme. One division. Small angles keep their
+// relative precision.
+inline double atan2_upper(double y, double x) {
+  const double ax = std::abs(x);
+  const double a = std::min(y, ax), b = std::max(y, ax);  // t = a / b in [0, 1]
+  const double mid = 0.5 - std::copysign(0.5, 0.41421356237309503 * b - a);  // 1 iff atan(t) > pi / 8
+  const double t = (a - mid * b) / (b + mid * a);
+  // The result is off + scale * atan(t): atan(a / b) = mid pi / 4 + atan(t);
+  // y > |x| (keep = -1) takes pi / 2 minus it, x < 0 (sx = -1) pi minus
+  // that. Formed in parallel with the division.
+  const double keep = std::copysign(1.0, ax - y), sx = std::copysign(1.0, x);
+  const double scale = sx * keep;
+  const double off = scale * mid * (std::numbers::pi / 4.0) + sx * (0.5 - 0.5 * keep) * (std::numbers::pi / 2.0) +
+                     (0.5 - 0.5 * sx) * std::numbers::pi;
+  const double z = t * t, z2 = z * z, z4 = z2 * z2;
+  const double p01 = -0.33333333333330926096 + 0.199999999977248869 * z;
+  const double p23 = -0.1428571393037856691 + 0.1111108964921105538 * z;
+  const double p45 = -0.090902559526906562104 + 0.076810452027429472637 * z;
+  const double p67 = -0.065509073075630907133 + 0.051688349359193618931 * z;
+  const double p = (p01 + z2 * p23) + z4 * ((p45 + z2 * p67) + z4 * -0.027232884060574881754);
+  const double st = scale * t;
+  return off + (st + st * z * p);
+}
+
+// sin and cos of a in [0, pi/2] to a few ulp of double (relative; sin keeps
+// its relative precision for small a), without a branch or a libm call:
+// s = a + a z S(z), c = 1 + z C(z), z = a^2, S and C of degree 6 Chebyshev
+// fits on [0, (pi/2)^2] (mpmath.chebyfit, 40 digits; relative errors below
+// 5e-16 and 8e-15), evaluated by Estrin's scheme.
+inline void sincos_quadrant(double a, double& s, double& c) {
+  const double z = a * a, z2 = z * z, z4 = z2 * z2;
+  const double s01 = -0.16666666666666648035 + 0.0083333333333259326765 * z;
+  const double s23 = -0.00019841269836469024924 + 2.7557318055685784254e-6 * z;
+  const double s45 = -2.5051972921545551591e-8 + 1.6050972244135634775e-10 * z;
+  s = a + a * z * ((s01 + z2 * s23) + z4 * (s45 + z2 * -7.4080548895426098568e-13));
+  const double c01 = -0.49999999999999684203 + 0.041666666666541228256 * z;
+  const double c23 = -0.0013888888880751316294 + 0.000024801585321095496471 * z;
+  const double c45 = -2.7557089550661794834e-7 + 2.086306804599395415e-9 * z;
+  c = 1.0 + z * ((c01 + z2 * c23) + z4 * (c45 + z2 * -1.1064990517793409977e-11));
+}
+
+// Square roots, and their reciprocals, of four doubles: one packed square
+// root (and one packed division) where AVX is available, four otherwise.
+// Square roots and divisions share one slow unit; packed, four cost about
+// as much as one. Built in registers (four scalar stores read back as one
+// vector would stall store-to-load forwarding).
+inline std::array<double, 4> sqrt4(double a, double b, double c, double d) {
+  std::array<double, 4> y;
+#if defined(__AVX__)
+  _mm256_storeu_pd(y.data(), _mm256_sqrt_pd(_mm256_set_pd(d, c, b, a)));
+#else
+  y = {std::sqrt(a), std::sqrt(b), std::sqrt(c), std::sqrt(d)};
+#endif
+  return y;
+}
+inline std::array<double, 4> inverse_sqrt4(double a, double b, double c, double d) {
+  std::array<double, 4> y;
+#if defined(__AVX__)
+  _mm256_storeu_pd(y.data(), _mm256_div_pd(_mm256_set1_pd(1.0), _mm256_sqrt_pd(_mm256_set_pd(d, c, b, a))));
+#else
+  y = {1.0 / std::sqrt(a), 1.0 / std::sqrt(b), 1.0 / std::sqrt(c), 1.0 / std::sqrt(d)};
+#endif
+  return y;
+}
+
+}  // namespace spherical_rectangle_detail
+
 // Light-sampling strategy: uniform in solid angle (spherical rectangle),
 // with the area fallback of spherical_rectangle. One-sided: an observer on
 // the back of the light or in its plane gets no sample and pdf 0.
+//
+// Two paths, chosen from (rectangle, observer) alone, so sample() and pdf()
+// always take the same one:
+//  * the fast path: UFK13's algorithm (sec. 3 and 4) with the formulas of
+//    spherical_rectangle::sample_local, in double in the local frame cached
+//    at construction, with S from Van Oosterom-Strackee on the two triangles
+//    of the rectangle (no cut at the foot of the observer: the predicate
+//    below excludes the configurations where that cancels), no libm call
+//    (atan2_upper for S, sincos_quadrant for the map), square roots packed
+//    four at a time (sqrt4, inverse_sqrt4), and no division where a product
+//    does. The sub-area u S enters the addition theorem through sin(u S) and
+//    cos(u S) - 1, formed from sin and cos of u S / 4 so that both keep the
+//    relative precision of u S (it is never rounded against k ~ pi).
+//    Accuracy: S, and the pdf 1/S, to a few ulp of double (the polynomials
+//    are accurate to 5e-15); the map's first coordinate to ~eps / (S sin_e)
+//    relative (sin_e = h / r_max, see spherical_rectangle), the second to
+//    ~eps / sin_e^2, so that directions agree with spherical_rectangle's to
+//    the rounding of a float direction (tests);
+//  * the exact path, spherical_rectangle (foot split, Newton polish, area
+//    fallback), where those bounds could pass 1e-8 (fast_view):
+//    grazing views, sin_e < fast_min_sine; small solid angles, S sin_e <
+//    fast_min_solid_angle_sine (spherical_rectangle would polish the map by
+//    Newton steps below 2.2e-7); a Van Oosterom-Strackee factor of modulus
+//    < fast_min_vos_factor times the product of its three distances (seen
+//    from near a long rectangle, its ends almost opposite, the factor
+//    cancels); and corner distances^2 outside [1e-60, 1e60] (the factors
+//    are of the order r^3, their product r^6). Every observer of the
+//    samplers' benchmark (bench/observers.hpp: 0.2 to 5 sizes away, at least
+//    3 degrees above the plane) takes the fast path.
 struct rect_solid_angle_sampler {
-  rect shape;
+  rect shape;  // fixed after construction (the frame below is derived from it)
+
+  static constexpr double fast_min_sine = 1e-3;
+  static constexpr double fast_min_solid_angle_sine = 1e-6;
+  static constexpr double fast_min_vos_factor = 1e-3;
+
+  explicit rect_solid_angle_sampler(const rect& r) : shape(r) {
+    // The frame of spherical_rectangle, computed the same way, so h and the
+    // facing decision are the same on both paths.
+    const dvec3 e1 = r.e1, e2 = r.e2;
+    w_ = glm::length(e1);
+    ex_ = e1 / w_;
+    const dvec3 e2o = e2 - glm::dot(e2, ex_) * ex_;
+    l_ = glm::length(e2o);
+    ey_ = e2o / l_;
+    ez_ = glm::cross(ex_, ey_);
+    if (glm::dot(ez_, dvec3(r.n)) < 0.0) ez_ = -ez_;
+  }
 
   bool faces(const vec3& o) const {
     const dvec3 n = glm::cross(dvec3(shape.e1), dvec3(shape.e2));
     return glm::dot(dvec3(o) - dvec3(shape.corner), n) * double(glm::dot(dvec3(n), dvec3(shape.n))) > 0.0;
   }
 
+  // Whether o is served by the fast path (for tests and benchmarks).
+  bool fast_path(const vec3& o) const { return fast_view(o).path == path_kind::fast; }
+
   bool sample(const vec3& o, vec2 u, light_sample& s) const {
+    const view v = fast_view(o);
+    if (v.path == path_kind::fast) return sample_fast(v, u, s);
+    return v.path == path_kind::exact && sample_exact(o, u, s);
+  }
+
+  // Density per unit SOLID ANGLE at o of the unit direction dir: 1/S on the
+  // spherical map, t^3 / (h A) on the area fallback, 0 if the ray misses or
+  // o does not face the light.
+  float pdf(const vec3& o, const vec3& dir) const {
+    const view v = fast_view(o);
+    if (v.path == path_kind::none) return 0.0f;
+    if (v.path == path_kind::exact) return pdf_exact(o, dir);
+    // The ray against the rectangle in the local frame, as
+    // spherical_rectangle::intersect. Edges count as inside.
+    const dvec3 dd(dir);
+    const double dz = glm::dot(dd, ez_);
+    if (!(dz < 0.0)) return 0.0f;  // parallel to the plane or going away from it
+    const double t = v.h / -dz;
+    const double x = t * glm::dot(dd, ex_), y = t * glm::dot(dd, ey_);
+    if (!(x >= v.x0 && x <= v.x1 && y >= v.y0 && y <= v.y1)) return 0.0f;
+    return float(1.0 / v.solid_angle);
+  }
+
+ private:
+  enum class path_kind { none, fast, exact };
+  // What sample() and pdf() share for one observer: the local coordinates of
+  // spherical_rectangle (the rectangle is [x0, x1] x [y0, y1] in the plane
+  // z = -h), the distances r00, r01 to the corners (x0, y0), (x0, y1) and S.
+  struct view {
+    path_kind path = path_kind::none;
+    double x0 = 0.0, x1 = 0.0, y0 = 0.0, y1 = 0.0, h = 0.0, solid_angle = 0.0, r00 = 0.0, r01 = 0.0;
+  };
+
+  view fast_view(const vec3& o) const {
+    using namespace spherical_rectangle_detail;
+    view v;
+    const dvec3 d = dvec3(shape.corner) - dvec3(o);  // exact: a difference of floats in double
+    v.h = -glm::dot(d, ez_);
+    v.x0 = glm::dot(d, ex_);
+    v.y0 = glm::dot(d, ey_);
+    v.x1 = v.x0 + w_;
+    v.y1 = v.y0 + l_;
+    // Behind or in the plane (also NaN): no sample, as spherical_rectangle.
+    if (!(v.h > 0.0)) return v;
+    v.path = path_kind::exact;
+    const double x0 = v.x0, x1 = v.x1, y0 = v.y0, y1 = v.y1, h2 = v.h * v.h;
+    const double xx0 = x0 * x0, xx1 = x1 * x1, yy0 = y0 * y0, yy1 = y1 * y1;
+    const double r00 = xx0 + yy0 + h2, r10 = xx1 + yy0 + h2, r11 = xx1 + yy1 + h2, r01 = xx0 + yy1 + h2;
+    const double r_max2 = std::max(std::max(r00, r11), std::max(r10, r01));
+    if (!(h2 >= fast_min_sine * fast_min_sine * r_max2) || !(r_max2 <= 1e60 && h2 >= 1e-60)) return v;
+    // Van Oosterom-Strackee on the triangles (v00, v10, v11) and (v00, v11,
+    // v01): the factor of each is r_a r_b r_c + (a.b) r_c + (a.c) r_b +
+    // (b.c) r_a + i h w l, and S / 2 is the argument of their product (see
+    // solid_angle_local_rect).
+    const std::array<double, 4> r = sqrt4(r00, r10, r11, r01);
+    const double ac = x0 * x1 + y0 * y1 + h2;  // v00 . v11, the shared diagonal
+    const double r0011 = r[0] * r[2];
+    const double d1 = r0011 * r[1] + (x0 * x1 + yy0 + h2) * r[2] + ac * r[1] + (xx1 + y0 * y1 + h2) * r[0];
+    const double d2 = r0011 * r[3] + ac * r[3] + (xx0 + y0 * y1 + h2) * r[2] + (x0 * x1 + yy1 + h2) * r[0];
+    const double n = v.h * w_ * l_;
+    v.solid_angle = 2.0 * atan2_upper(n * (d1 + d2), d1 * d2 - n * n);
+    v.r00 = r[0];
+    v.r01 = r[3];
+    // The factors carry absolute errors of a few ulp of r_a r_b r_c (the
+    // dot products); the half angles, of a few ulp times r_a r_b r_c /
+    // |factor|, which fast_min_vos_factor bounds. Small S: see the class
+    // comment.
+    const double rrr1 = r0011 * r[1], rrr2 = r0011 * r[3];
+    const double z2 = std::min((d1 * d1 + n * n) / (rrr1 * rrr1), (d2 * d2 + n * n) / (rrr2 * rrr2));
+    const double s2 = v.solid_angle * v.solid_angle;
+    if (z2 >= fast_min_vos_factor * fast_min_vos_factor &&
+        s2 * h2 >= fast_min_solid_angle_sine * fast_min_solid_angle_sine * r_max2)
+      v.path = path_kind::fast;
+    return v;
+  }
+
+  // UFK13 sec. 4 on the fast path, with the formulas (and notation) of
+  // spherical_rectangle::sample_local.
+  bool sample_fast(const view& v, vec2 u, light_sample& s) const {
+    using namespace spherical_rectangle_detail;
+    const double h = v.h, h2 = h * h, x0 = v.x0, y0 = v.y0, y1 = v.y1;
+    const double q0sq = y0 * y0 + h2, q1sq = y1 * y1 + h2, p0 = x0 * x0 + h2;
+    const double xmax2 = std::max(x0 * x0, v.x1 * v.x1);
+    const std::array<double, 4> iq = inverse_sqrt4(q0sq, q1sq, p0, xmax2);
+    const double iq0 = iq[0], iq1 = iq[1], ip = iq[2], r00 = v.r00, r01 = v.r01;
+    const double b0 = -y0 * iq0, b1 = y1 * iq1, c0sq = h2 * iq0 * iq0;
+    // cos and sin of k = 2 pi - gamma_2 - gamma_3; inv = 1 / (p0 q0 q1).
+    // Every term is bounded by 1 after the scaling by inv, so their absolute
+    // errors are a few eps.
+    const double inv = iq0 * iq1 * ip * ip;
+    const double cos_k = -(x0 * x0 * y0 * y1 + h2 * r00 * r01) * inv;
+    const double sin_k = -h * x0 * (y1 * r00 - y0 * r01) * inv;
+    // au = u S + k by the addition theorem, from sin and cos of u S / 4:
+    // sin(u S) = 4 s c (1 - 2 s^2), cos(u S) - 1 = -8 (s c)^2.
+    double sq, cq;
+    sincos_quadrant(double(u.x) * (0.25 * v.solid_angle), sq, cq);
+    const double sc = sq * cq;
+    const double sp = 4.0 * sc * (1.0 - 2.0 * sq * sq), cm = -8.0 * sc * sc;
+    const double cos_au = cos_k + (cm * cos_k - sp * sin_k);
+    const double sin_au = sin_k + (sp * cos_k + cm * sin_k);
+    // x_u = h sign(N) D / sqrt(den2), den2 = N^2 - c0^2 D^2, D = sin(au).
+    // den2 is kept >= h^2 D^2 / max(x0^2, x1^2), i.e. |x_u| within the
+    // rectangle (it rounds below only where x_u is beyond it), and > 0.
+    const double N = cos_au * b0 - b1, D2 = sin_au * sin_au;
+    const double den2 = std::max({N * N - c0sq * D2, D2 * (h2 * iq[3] * iq[3]), DBL_MIN});
+    // Second stage (UFK13 sec. 4): h_v = sin(elevation) uniform between h_0
+    // and h_1 along x = x_u. With m = den2 + D^2, x_u^2 + h^2 = h^2 m / den2,
+    // so h_j = y_j / sqrt(x_u^2 + h^2 + y_j^2) = y_j sqrt(den2) /
+    // sqrt(h^2 m + y_j^2 den2), and the plane x = x_u is at the angle alpha
+    // from the vertical, cos alpha = h / sqrt(x_u^2 + h^2) = sqrt(den2 / m),
+    // sin alpha = x_u / sqrt(x_u^2 + h^2) = sign(N D) |D| / sqrt(m): one
+    // packed square root and division for all of them, no other.
+    const double m = den2 + D2;
+    const std::array<double, 4> ir = inverse_sqrt4(h2 * m + y0 * y0 * den2, h2 * m + y1 * y1 * den2, m, den2);
+    const double sqrt_den2 = den2 * ir[3];
+    const double h0 = y0 * sqrt_den2 * ir[0], h1 = y1 * sqrt_den2 * ir[1];
+    const double hv = h0 + double(u.y) * (h1 - h0);
+    const double cos_alpha = sqrt_den2 * ir[2], sin_alpha = std::copysign(std::abs(sin_au) * ir[2], N * sin_au);
+    // The unit direction is cos(elevation) (sin alpha, 0, -cos alpha) + h_v
+    // ey. 1 - h_v^2 >= (h / r_max)^2 >= fast_min_sine^2: the product form
+    // loses at most eps / fast_min_sine^2 ~ 2e-10.
+    const double ce = std::sqrt((1.0 - hv) * (1.0 + hv));
+    s.dir = vec3((ce * sin_alpha) * ex_ + hv * ey_ - (ce * cos_alpha) * ez_);
+    s.dist = float(h / (ce * cos_alpha));
+    s.pdf = float(1.0 / v.solid_angle);
+    return true;
+  }
+
+  bool sample_exact(const vec3& o, vec2 u, light_sample& s) const {
     const spherical_rectangle sr(shape, o);
     if (!sr.valid()) return false;
     const dvec3 v = sr.sample_offset(u);
@@ -351,16 +621,16 @@ struct rect_solid_angle_sampler {
     return s.pdf > 0.0f;
   }
 
-  // Density per unit SOLID ANGLE at o of the unit direction dir: 1/S on the
-  // spherical map, t^3 / (h A) on the area fallback, 0 if the ray misses or
-  // o does not face the light.
-  float pdf(const vec3& o, const vec3& dir) const {
+  float pdf_exact(const vec3& o, const vec3& dir) const {
     const spherical_rectangle sr(shape, o);
     double t;
     if (!sr.intersect(dvec3(dir), t)) return 0.0f;
     const double p = sr.pdf_offset(t * dvec3(dir));
     return p <= double(FLT_MAX) ? float(p) : 0.0f;
   }
+
+  dvec3 ex_{1.0, 0.0, 0.0}, ey_{0.0, 1.0, 0.0}, ez_{0.0, 0.0, 1.0};
+  double w_ = 1.0, l_ = 1.0;
 };
 
 }  // namespace mcrt
