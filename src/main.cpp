@@ -18,7 +18,7 @@ using namespace mcrt::cli;
 
 struct render_options {
   std::string scene, output, stats, light_sampling;
-  std::optional<int> spp, width, height, max_depth;
+  std::optional<int> spp, width, height, max_depth, rr_depth;
   std::optional<unsigned> threads;
   std::uint64_t seed = 0;
   bool quiet = false;
@@ -67,6 +67,7 @@ int run_render(const render_options& opt) {
   check_range(opt.width, "--width", 1, max_resolution);
   check_range(opt.height, "--height", 1, max_resolution);
   check_range(opt.max_depth, "--max-depth", 0, max_depth_limit);
+  check_range(opt.rr_depth, "--rr-depth", 0, max_depth_limit);
   if (opt.threads && *opt.threads == 0) throw input_error("--threads: must be >= 1");
   std::optional<light_sampling> strategy;
   if (!opt.light_sampling.empty())
@@ -86,6 +87,7 @@ int run_render(const render_options& opt) {
   rs.height = opt.height.value_or(ls.cam.height);
   rs.spp = opt.spp.value_or(ls.spp);
   rs.max_depth = opt.max_depth.value_or(ls.max_depth);
+  if (opt.rr_depth) rs.rr_depth = *opt.rr_depth;
   rs.seed = opt.seed;
   rs.threads = opt.threads.value_or(0u);
 
@@ -113,6 +115,7 @@ int run_render(const render_options& opt) {
     j["light_sampling"] = strategy_used;
     j["seed"] = rs.seed;
     j["max_depth"] = rs.max_depth;
+    j["rr_depth"] = rs.rr_depth;
     j["scene"] = ls.name;
     j["nonfinite_samples"] = res.nonfinite_samples;
     write_text(opt.stats, j.dump(2) + "\n");
@@ -167,6 +170,8 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--width", ro.width, "Image width in pixels (overrides the scene; keeps the view)");
   render_cmd->add_option("--height", ro.height, "Image height in pixels (overrides the scene; keeps the view)");
   render_cmd->add_option("--max-depth", ro.max_depth, "Maximum number of scattering events (overrides the scene)");
+  render_cmd->add_option("--rr-depth", ro.rr_depth,
+                         "Scattering events before Russian roulette starts (default 3; >= max depth: off)");
   render_cmd->add_option("--seed", ro.seed, "Random seed (default 0)");
   render_cmd->add_option("--threads", ro.threads, "Threads (default: all hardware threads)");
   render_cmd->add_option("--light-sampling", ro.light_sampling, "Sample every light by area or solid angle")

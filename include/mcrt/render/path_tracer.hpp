@@ -42,17 +42,15 @@ color trace_path(const Scene& sc, ray r, pcg32& rng, const path_settings& ps) {
     }
     if (depth == ps.max_depth) break;
     if (depth >= ps.rr_depth) {
-      const float q = dispatch(m, [](const auto& mat) {
-            using M = std::decay_t<decltype(mat)>;
-            if constexpr (std::is_same_v<M, dielectric>)
-              return 0.95f;
-            else if constexpr (std::is_same_v<M, diffuse_light>)
-              return 0.0f;
-            else
-              return survival_probability(mat.albedo);
-          });
-      if (!(rng.uniform() < q)) break;
-      throughput /= q;
+      // Russian roulette on the throughput (as pbrt-v4): a path whose
+      // throughput is below 1 survives with that probability; one at or
+      // above 1 always continues, so the roulette never raises a path's
+      // weight above 1 and adds no fireflies.
+      const float q = std::max({throughput.r, throughput.g, throughput.b});
+      if (q < 1.0f) {
+        if (!(rng.uniform() < q)) break;
+        throughput /= q;
+      }
     }
 
     if (const auto* lam = std::get_if<lambertian>(&m)) {
