@@ -171,7 +171,7 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--height", ro.height, "Image height in pixels (overrides the scene; keeps the view)");
   render_cmd->add_option("--max-depth", ro.max_depth, "Maximum number of scattering events (overrides the scene)");
   render_cmd->add_option("--rr-depth", ro.rr_depth,
-                         "Scattering events before Russian roulette starts (default 3; >= max depth: off)");
+                         "Scattering events before Russian roulette starts (default 1; >= max depth: off)");
   render_cmd->add_option("--seed", ro.seed, "Random seed (default 0)");
   render_cmd->add_option("--threads", ro.threads, "Threads (default: all hardware threads)");
   render_cmd->add_option("--light-sampling", ro.light_sampling, "Sample every light by area or solid angle")

@@ -13,18 +13,11 @@ namespace mcrt {
 
 struct path_settings {
   int max_depth = 50;  // maximum number of scattering events along a path
-  // Russian roulette (Arvo & Kirk 1990) from this many scattering events on:
-  // a path survives each further scattering with probability
-  // q = min(max albedo component, 0.95) and its throughput is divided by q,
-  // which keeps the estimator unbiased while cutting the long tail of paths.
-  // A value >= max_depth turns it off.
-  int rr_depth = 3;
+  // Russian roulette (Arvo & Kirk 1990) from this many scattering events on,
+  // on the path's throughput as pbrt-v4 does (from the second scattering):
+  // see trace_path. Unbiased; a value >= max_depth turns it off.
+  int rr_depth = 1;
 };
-
-// Survival probability of Russian roulette at a surface of this albedo.
-inline float survival_probability(const color& albedo) {
-  return std::min(std::max({albedo.r, albedo.g, albedo.b}), 0.95f);
-}
 
 template <class Scene>
 color trace_path(const Scene& sc, ray r, pcg32& rng, const path_settings& ps) {

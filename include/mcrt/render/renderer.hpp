@@ -22,7 +22,7 @@ struct render_settings {
   int width = 600, height = 600;
   int spp = 100;
   int max_depth = 50;
-  int rr_depth = 3;  // see path_settings
+  int rr_depth = 1;  // see path_settings
   std::uint64_t seed = 0;
   unsigned threads = 0;  // 0: all hardware threads
 };
