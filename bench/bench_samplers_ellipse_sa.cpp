@@ -11,30 +11,17 @@
 
 namespace {
 
-template <class Sampler>
-void run(benchmark::State& state, const Sampler& sampler, const std::vector<mcrt::vec3>& obs) {
-  mcrt::pcg32 rng(1, 2);
-  std::size_t i = 0;
-  for (auto _ : state) {
-    const mcrt::vec3& o = obs[i++ & (obs.size() - 1)];
-    mcrt::light_sample s;
-    if (sampler.sample(o, rng.uniform2(), s)) benchmark::DoNotOptimize(sampler.pdf(o, s.dir));
-    benchmark::DoNotOptimize(s);
-  }
-  state.SetItemsProcessed(state.iterations());
-}
-
 const mcrt::ellipse bench_light = mcrt::ellipse::make({278, 554, 279.5}, {65, 0, 0}, {0, 0, 65});
 
 void BM_SampleEllipseSolidAngle(benchmark::State& state) {
   const mcrt::ellipse_solid_angle_sampler s{bench_light};
-  run(state, s, mcrt::bench::observers_around(s.shape.center, s.shape.n, 130.0f));
+  mcrt::bench::run_sample_and_pdf(state, s, mcrt::bench::observers_around(s.shape.center, s.shape.n, 130.0f));
 }
 BENCHMARK(BM_SampleEllipseSolidAngle);
 
 void BM_SampleEllipseSolidAngleBisectionSimpson(benchmark::State& state) {
   const mcrt::ellipse_solid_angle_sampler_bisection_simpson s{bench_light};
-  run(state, s, mcrt::bench::observers_around(s.shape.center, s.shape.n, 130.0f));
+  mcrt::bench::run_sample_and_pdf(state, s, mcrt::bench::observers_around(s.shape.center, s.shape.n, 130.0f));
 }
 BENCHMARK(BM_SampleEllipseSolidAngleBisectionSimpson);
 

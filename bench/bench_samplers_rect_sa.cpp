@@ -16,15 +16,7 @@ void BM_SampleRectSolidAngle(benchmark::State& state) {
   const mcrt::rect_solid_angle_sampler sampler{mcrt::xz_rect(213, 343, 227, 332, 554, true)};
   const std::vector<mcrt::vec3> obs =
       mcrt::bench::observers_around(sampler.shape.center(), sampler.shape.n, 130.0f);
-  mcrt::pcg32 rng(1, 2);
-  std::size_t i = 0;
-  for (auto _ : state) {
-    const mcrt::vec3& o = obs[i++ & (obs.size() - 1)];
-    mcrt::light_sample s;
-    if (sampler.sample(o, rng.uniform2(), s)) benchmark::DoNotOptimize(sampler.pdf(o, s.dir));
-    benchmark::DoNotOptimize(s);
-  }
-  state.SetItemsProcessed(state.iterations());
+  mcrt::bench::run_sample_and_pdf(state, sampler, obs);
   std::size_t fast = 0;
   for (const mcrt::vec3& o : obs) fast += sampler.fast_path(o);
   state.counters["fast_path"] = double(fast) / double(obs.size());

@@ -1,10 +1,14 @@
 #pragma once
-// Observer positions spread around a light, shared by the sampler
-// benchmarks so every sampler is timed on the same set of points.
+// What the sampler benchmarks share: observer positions spread around a
+// light, so every sampler is timed on the same set of points, and the timed
+// loop itself (one sample plus its pdf per iteration).
+#include <benchmark/benchmark.h>
+
 #include <vector>
 
 #include "mcrt/core/math.hpp"
 #include "mcrt/core/rng.hpp"
+#include "mcrt/sampling/light_sample.hpp"
 
 namespace mcrt::bench {
 
@@ -27,6 +31,21 @@ inline std::vector<vec3> observers_around(const vec3& center, const vec3& n, flo
     out.push_back(center + dist * dir);
   }
   return out;
+}
+
+// Times sampler.sample plus sampler.pdf for the sampled direction, cycling
+// through the observers (their count must be a power of two).
+template <class Sampler>
+void run_sample_and_pdf(benchmark::State& state, const Sampler& sampler, const std::vector<vec3>& obs) {
+  pcg32 rng(1, 2);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const vec3& o = obs[i++ & (obs.size() - 1)];
+    light_sample s;
+    if (sampler.sample(o, rng.uniform2(), s)) benchmark::DoNotOptimize(sampler.pdf(o, s.dir));
+    benchmark::DoNotOptimize(s);
+  }
+  state.SetItemsProcessed(state.iterations());
 }
 
 }  // namespace mcrt::bench
