@@ -111,6 +111,28 @@ inline void multiply_vos_factors(double x0, double x1, double y0, double y1, dou
   re = r;
 }
 
+// The rectangle's orthonormal frame in double: x along e1, y along the part
+// of e2 orthogonal to e1, z the front normal (e1 x e2 oriented by r.n); w and
+// l the side lengths. One function for both sampling paths, so that the
+// height and the facing decision are the same on both.
+struct rect_frame {
+  dvec3 ex, ey, ez;
+  double w, l;
+};
+
+inline rect_frame make_rect_frame(const rect& r) {
+  rect_frame f;
+  const dvec3 e1 = r.e1, e2 = r.e2;
+  f.w = glm::length(e1);
+  f.ex = e1 / f.w;
+  const dvec3 e2o = e2 - glm::dot(e2, f.ex) * f.ex;
+  f.l = glm::length(e2o);
+  f.ey = e2o / f.l;
+  f.ez = glm::cross(f.ex, f.ey);
+  if (glm::dot(f.ez, dvec3(r.n)) < 0.0) f.ez = -f.ez;
+  return f;
+}
+
 }  // namespace spherical_rectangle_detail
 
 // Solid angle of the rectangle [x0, x1] x [y0, y1] in the plane z = -h, h > 0,
@@ -166,14 +188,8 @@ class spherical_rectangle {
   spherical_rectangle(const rect& r, const vec3& o) : o_(o), e1_(r.e1), e2_(r.e2) {
     // Orthonormal frame in double (see the header comment); z is the front
     // normal, taken from e1 x e2 in double and oriented by r.n.
-    const dvec3 e1 = e1_, e2 = e2_;
-    w_ = glm::length(e1);
-    ex_ = e1 / w_;
-    const dvec3 e2o = e2 - glm::dot(e2, ex_) * ex_;
-    l_ = glm::length(e2o);
-    ey_ = e2o / l_;
-    ez_ = glm::cross(ex_, ey_);
-    if (glm::dot(ez_, dvec3(r.n)) < 0.0) ez_ = -ez_;
+    const spherical_rectangle_detail::rect_frame f = spherical_rectangle_detail::make_rect_frame(r);
+    ex_ = f.ex, ey_ = f.ey, ez_ = f.ez, w_ = f.w, l_ = f.l;
     area_ = w_ * l_;
 
     const dvec3 d = dvec3(r.corner) - dvec3(o);  // exact: a difference of floats in double
@@ -457,16 +473,10 @@ struct rect_solid_angle_sampler {
   static constexpr double fast_min_vos_factor = 1e-3;
 
   explicit rect_solid_angle_sampler(const rect& r) : shape(r) {
-    // The frame of spherical_rectangle, computed the same way, so h and the
+    // The frame of spherical_rectangle, from the same function, so h and the
     // facing decision are the same on both paths.
-    const dvec3 e1 = r.e1, e2 = r.e2;
-    w_ = glm::length(e1);
-    ex_ = e1 / w_;
-    const dvec3 e2o = e2 - glm::dot(e2, ex_) * ex_;
-    l_ = glm::length(e2o);
-    ey_ = e2o / l_;
-    ez_ = glm::cross(ex_, ey_);
-    if (glm::dot(ez_, dvec3(r.n)) < 0.0) ez_ = -ez_;
+    const spherical_rectangle_detail::rect_frame f = spherical_rectangle_detail::make_rect_frame(r);
+    ex_ = f.ex, ey_ = f.ey, ez_ = f.ez, w_ = f.w, l_ = f.l;
   }
 
   bool faces(const vec3& o) const {
