@@ -1,7 +1,9 @@
 #pragma once
 // mcrt: a header-only Monte-Carlo path tracer for studying direct sampling
 // of area lights. Include this for everything, or the single headers.
+#include "mcrt/core/carlson.hpp"
 #include "mcrt/core/dispatch.hpp"
+#include "mcrt/core/fast_math.hpp"
 #include "mcrt/core/math.hpp"
 #include "mcrt/core/onb.hpp"
 #include "mcrt/core/ray.hpp"

@@ -65,6 +65,7 @@
 #include <numbers>
 
 #include "mcrt/core/carlson.hpp"
+#include "mcrt/core/fast_math.hpp"
 #include "mcrt/core/math.hpp"
 #include "mcrt/geometry/ellipse.hpp"
 #include "mcrt/sampling/ellipse_area.hpp"
@@ -116,15 +117,20 @@ inline double spherical_ellipse_half_partial_area(const spherical_ellipse& se, s
 // duplication form loses ~b ulps). eps_j in [0, 1) since p_0^2 >= 1 >= g_0.
 inline double spherical_ellipse_area(const spherical_ellipse& se) {
   const double a2 = se.a * se.a, b2 = se.b * se.b;
-  double an = 1.0, gn = std::sqrt((1.0 + b2) / (1.0 + a2)), pn = std::sqrt(1.0 + b2);
+  const double inv_sa = 1.0 / std::sqrt(1.0 + a2);
+  double an = 1.0, pn = std::sqrt(1.0 + b2), gn = pn * inv_sa;
   double r = 0.0, prod = 1.0, w = 0.5, sum = 0.0;
   // The AGM converges quadratically; p_j halves per step while p_j >> 1,
   // so wide cones take ~log2(b) steps (b <= 1e6 in the sampler: ~25).
+  // One division per step: inv = 1 / (den p_j) gives both 1 / den and
+  // p_{j+1} = den / (2 p_j).
   for (int j = 0; j < 100; ++j) {
-    const double ag = an * gn, den = pn * pn + ag;
+    const double ag = an * gn, pp = pn * pn, den = pp + ag;
+    const double inv = 1.0 / (den * pn);
     if (prod > 0.0) {
-      const double eps = (pn * pn - ag) / den;
-      r = r * eps + 2.0 * ag / den;
+      const double inv_den = pn * inv;
+      const double eps = (pp - ag) * inv_den;
+      r = r * eps + 2.0 * ag * inv_den;
       prod *= eps;
       sum += w * r;
       // Once eps_0 ... eps_j is below the rounding of R, R_k = 1 for all
@@ -135,14 +141,14 @@ inline double spherical_ellipse_area(const spherical_ellipse& se) {
       }
       w *= 0.5;
     }
-    pn = den / (2.0 * pn);
+    pn = 0.5 * den * den * inv;
     const double an1 = 0.5 * (an + gn);
     gn = std::sqrt(ag);
     an = an1;
     if (prod == 0.0 && std::abs(an - gn) <= 1e-15 * an) break;
   }
   const double j = 0.25 * std::numbers::pi / an * sum;
-  return 4.0 * se.a * se.b / std::sqrt(1.0 + a2) * j;
+  return 4.0 * se.a * se.b * inv_sa * j;
 }
 
 // Closed form + safeguarded Newton (the paper's recommendation).
@@ -160,9 +166,11 @@ struct newton_carlson_solver {
   }
 
   // The slice with Omega_p = u1 Omega; `iterations` (optional) reports the
-  // number of area evaluations.
+  // number of Newton or bisection steps taken (closed-form evaluations plus
+  // local quadratures, see below).
   static spherical_ellipse_slice invert(const spherical_ellipse& se, double omega, double u1,
                                         int* iterations = nullptr) {
+    using fast_math::sincos_quadrant;
     constexpr double half_pi = 0.5 * std::numbers::pi;
     // Omega_p - Omega/2 is odd in psi: solve for |psi| on [0, pi/2].
     const double target = (u1 - 0.5) * omega;
@@ -176,28 +184,46 @@ struct newton_carlson_solver {
     // Newton steps on that cheap equation.
     const double v = goal / half;
     double psi = v < 0.5 ? 0.25 * std::numbers::pi * v : half_pi - std::cbrt(0.75 * std::numbers::pi * (1.0 - v));
+    spherical_ellipse_slice sl;
     for (int i = 0; i < 2; ++i) {
-      const double c = std::cos(psi);
-      const double fp = 4.0 * c * c;
+      sincos_quadrant(psi, sl.s, sl.c);
+      const double fp = 4.0 * sl.c * sl.c;
       if (!(fp > 1e-12)) break;  // at the end of the interval: keep the end estimate
-      psi = std::clamp(psi - (2.0 * psi + std::sin(2.0 * psi) - std::numbers::pi * v) / fp, 0.0, half_pi);
+      psi = std::clamp(psi - (2.0 * psi + 2.0 * sl.s * sl.c - std::numbers::pi * v) / fp, 0.0, half_pi);
     }
+    sincos_quadrant(psi, sl.s, sl.c);
     // Newton on f(psi) = Omega_p(psi) - Omega/2 - goal, increasing on
     // [0, pi/2]; the bracket [lo, hi] shrinks with the sign of f and a step
     // leaving it is replaced by bisection (f' -> 0 as cos^2 at the end).
+    //
+    // f is evaluated in closed form (Carlson) where the solver starts; after
+    // a step from psi to psi + d it is updated as f + int_psi^{psi+d} f',
+    // the integral by 4-point Gauss-Legendre, when |d| <= delta / 8.
+    // delta = min(1 / sqrt(1 + b^2), sqrt((1 + b^2) / (1 + a^2))) is a lower
+    // bound on the distance from the real axis of the singularities of f'
+    // (the zeros of 1 + b^2 sin^2 t at Im t = +-asinh(1/b) >= 1/sqrt(1 + b^2),
+    // and of 1 + a^2 cos^2 t + b^2 sin^2 t at Im t = +-acosh(1/sqrt(m)) >=
+    // sqrt(1 - m)), so f' is analytic in the Bernstein ellipse of parameter
+    // rho ~ 16 around the step, and the rule's relative error is below
+    // (64/15) rho^-8 / (rho^2 - 1) ~ 4e-12 times the ratio of f' at distance
+    // delta/2 to f' on the step (Trefethen, "Approximation Theory and
+    // Approximation Practice", thm. 19.3): negligible against the
+    // tolerance, for a quarter of the cost of a closed-form evaluation.
+    // Larger steps (from a poor start, or bisection) evaluate the closed form.
     //
     // f' (the slice density) decreases on [0, pi/2]: its log-derivative is
     // -2 tan psi - 2 b^2 s c / (1 + b^2 s^2) + (a^2 - b^2) s c / (1 + a^2 c^2 + b^2 s^2)
     // and the last term is at most a^2 s c / (a^2 c^2) = tan psi. So after a
     // Newton step d = -f / f'(psi) the new residual is
     //   |f(psi + d)| = |int_psi^{psi+d} (f'(t) - f'(psi)) dt| <= |d| |f'(psi + d) - f'(psi)|,
-    // a bound that costs one density instead of one closed-form area: a step
-    // whose bound is within the tolerance is accepted without evaluating f.
+    // a bound that costs one density instead of one closed-form area: a large
+    // step whose bound is within the tolerance is accepted without evaluating f.
+    const double local = 0.125 * std::min(1.0 / std::sqrt(1.0 + se.b * se.b),
+                                          std::sqrt((1.0 + se.b * se.b) / (1.0 + se.a * se.a)));
     double lo = 0.0, hi = half_pi;
-    spherical_ellipse_slice sl{std::sin(psi), std::cos(psi)};
+    double f = spherical_ellipse_half_partial_area(se, sl) - goal;
     for (int it = 1; it <= max_iterations; ++it) {
       if (iterations) *iterations = it;
-      const double f = spherical_ellipse_half_partial_area(se, sl) - goal;
       if (std::abs(f) <= tolerance * omega) break;
       (f < 0.0 ? lo : hi) = psi;
       const double fp = spherical_ellipse_slice_density(se, sl);
@@ -206,12 +232,45 @@ struct newton_carlson_solver {
       if (!newton) next = 0.5 * (lo + hi);
       if (next == psi) break;  // the bracket is down to one ulp
       const double step = next - psi;
+      if (std::abs(step) <= local) {
+        f += local_integral(se, sl, step);
+        psi = next;
+        sincos_quadrant(psi, sl.s, sl.c);
+        continue;
+      }
       psi = next;
-      sl = {std::sin(psi), std::cos(psi)};
+      sincos_quadrant(psi, sl.s, sl.c);
       if (newton && std::abs(step) * std::abs(spherical_ellipse_slice_density(se, sl) - fp) <= tolerance * omega)
         break;
+      f = spherical_ellipse_half_partial_area(se, sl) - goal;
     }
     return {sign * sl.s, sl.c};
+  }
+
+ private:
+  // int_psi^{psi+d} of the slice density by 4-point Gauss-Legendre (see
+  // invert), |d| <= pi/2. sin and cos at the nodes by the addition theorem
+  // from sl; the four 1 / ((1 + b^2 s^2) sqrt(1 + a^2 c^2 + b^2 s^2)) by one
+  // packed square root and division.
+  static double local_integral(const spherical_ellipse& se, spherical_ellipse_slice sl, double d) {
+    constexpr double x0 = 0.33998104358485626480, x1 = 0.86113631159405257522;  // nodes +-x0, +-x1
+    constexpr double w0 = 0.65214515486254614263, w1 = 0.34785484513745385737;
+    const double h = 0.5 * d, ah = std::abs(h);
+    const double offs[4] = {(1.0 - x1) * ah, (1.0 - x0) * ah, (1.0 + x0) * ah, (1.0 + x1) * ah};
+    const double sd = h < 0.0 ? -1.0 : 1.0;
+    const double a2 = se.a * se.a, b2 = se.b * se.b;
+    double c2[4], q[4];
+    for (int i = 0; i < 4; ++i) {
+      double sn, cs;
+      fast_math::sincos_quadrant(offs[i], sn, cs);
+      const double st = sl.s * cs + sd * sl.c * sn, ct = sl.c * cs - sd * sl.s * sn;
+      const double k = 1.0 + b2 * st * st;
+      c2[i] = ct * ct;
+      q[i] = k * k * (1.0 + a2 * c2[i] + b2 * st * st);
+    }
+    const std::array<double, 4> r = fast_math::inverse_sqrt4(q[0], q[1], q[2], q[3]);
+    const double sum = w1 * (c2[0] * r[0] + c2[3] * r[3]) + w0 * (c2[1] * r[1] + c2[2] * r[2]);
+    return 2.0 * se.a * se.b * h * sum;
   }
 };
 
@@ -374,8 +433,14 @@ inline void jacobi_eigen3(std::array<std::array<double, 3>, 3>& m, std::array<st
     bool rotated = false;
     for (int p = 0; p < 2; ++p) {
       for (int q = p + 1; q < 3; ++q) {
+        // Skip test |a_pq| <= 1e-15 sqrt(|a_pp a_qq|), squared (no square
+        // root): the relative criterion of Demmel & Veselic 1992. Skipping
+        // moves the eigenvalues by a relative 1e-15 at most (1e-30 unless
+        // a_pp ~ a_qq), leaves the graded small entries of thin or tiny
+        // cones alone, and spares the rotations of rounding-level entries
+        // (the symmetric frame of a disk leaves ~1e-17 ones).
         const double apq = m[p][q];
-        if (std::abs(apq) <= 1e-18 * std::sqrt(std::abs(m[p][p] * m[q][q])) || apq == 0.0) continue;
+        if (apq * apq <= 1e-30 * std::abs(m[p][p] * m[q][q])) continue;
         rotated = true;
         const double theta = (m[q][q] - m[p][p]) / (2.0 * apq);
         // t = tan of the rotation angle, the smaller root (|angle| <= pi/4);
@@ -405,39 +470,70 @@ inline void jacobi_eigen3(std::array<std::array<double, 3>, 3>& m, std::array<st
 
 }  // namespace detail
 
+// What the cone set-up needs of an ellipse, in double, computed once per
+// light: the centre and semi-axes, the front normal from a1 x a2 in double
+// (the float e.n is off the plane by ~1e-8, which would put an error of
+// 1e-8 dist / h in the height h) and |a1 x a2|.
+struct ellipse_frame {
+  dvec3 center{0.0}, a1{0.0}, a2{0.0}, n{0.0};
+  double cross_len = 0.0;
+  double flip = 1.0;  // +1 when the front normal is along a1 x a2, -1 when flipped
+
+  explicit ellipse_frame(const ellipse& e) : center(e.center), a1(e.a1), a2(e.a2) {
+    const dvec3 cr = glm::cross(a1, a2);
+    cross_len = glm::length(cr);
+    flip = glm::dot(cr, dvec3(e.n)) > 0.0 ? 1.0 : -1.0;
+    n = cr * (flip / cross_len);
+  }
+};
+
 // The cone of directions from o through the ellipse e, reduced to a
 // canonical spherical ellipse; mode says how the light is sampled from o.
 // Without Frame only mode, se and omega are set (all that a pdf needs):
 // the same rotations and the same arithmetic, so the same mode and omega,
-// without the eigenvectors and the maps to the ellipse.
+// without the eigenvectors and the maps to the ellipse. `f` is
+// ellipse_frame(e), which a sampler keeps.
 template <class Solver = newton_carlson_solver, bool Frame = true>
-inline ellipse_cone make_ellipse_cone(const ellipse& e, const vec3& o) {
+inline ellipse_cone make_ellipse_cone(const ellipse& e, const ellipse_frame& f, const vec3& o) {
   ellipse_cone cone;
   if (!e.faces(o)) return cone;  // mode none: behind or in the plane (the float test every sampler uses)
   cone.mode = ellipse_cone_mode::area;
-  const dvec3 od(o), cd(e.center), a1(e.a1), a2(e.a2);
-  // The front normal from a1 x a2 in double: the float e.n is off the
-  // plane by ~1e-8, which would put an error of 1e-8 dist / h in h.
-  const dvec3 cr = glm::cross(a1, a2);
-  const dvec3 n = cr / glm::length(cr) * (glm::dot(cr, dvec3(e.n)) > 0.0 ? 1.0 : -1.0);
-  cone.d = cd - od;
-  cone.dist = glm::length(cone.d);
-  const double h = glm::dot(od - cd, n);
+  const dvec3 od(o);
+  const dvec3& n = f.n;
+  cone.d = f.center - od;  // exact: a difference of floats in double
+  const double dist2 = glm::dot(cone.d, cone.d);
+  cone.dist = std::sqrt(dist2);
+  const double h = -glm::dot(cone.d, n);
   if (!(h > ellipse_cone_limits::min_height * cone.dist) || !std::isfinite(cone.dist)) return cone;
-  const dvec3 cdir = cone.d / cone.dist;
-  dvec3 t1, t2;
-  detail::onb_double(cdir, t1, t2);
+  const double inv_dist = 1.0 / cone.dist;
+  const dvec3 cdir = cone.d * inv_dist;
+  // Frame (t1, t2, cdir) with t1 along n x cdir, the normal of the plane
+  // through the observer, the centre and the ellipse's normal. For a disk
+  // that plane is a plane of symmetry of the cone and t1 one of its
+  // principal axes (P below is (R/dist)^2 (I - n n^T) - cdir cdir^T and
+  // t1 is orthogonal to n and cdir), so P is block-diagonal in this frame
+  // and Jacobi needs a single rotation; for other ellipses it is as good a
+  // start as any. The observer on the axis (n x cdir = 0, any frame is
+  // principal for a disk) takes the generic basis.
+  dvec3 t1 = glm::cross(n, cdir), t2;
+  t1 -= glm::dot(t1, cdir) * cdir;  // orthogonal to cdir to the last bit
+  const double t1_len2 = glm::dot(t1, t1);
+  if (t1_len2 > 1e-300) {
+    t1 *= 1.0 / std::sqrt(t1_len2);
+    t2 = glm::cross(cdir, t1);
+  } else {
+    detail::onb_double(cdir, t1, t2);
+  }
 
   // Axes in units of the distance, in the (t1, t2, cdir) frame.
-  const dvec3 u1 = a1 / cone.dist, u2 = a2 / cone.dist;
+  const dvec3 u1 = f.a1 * inv_dist, u2 = f.a2 * inv_dist;
   const double b00 = glm::dot(u1, t1), b01 = glm::dot(u2, t1);
   const double b10 = glm::dot(u1, t2), b11 = glm::dot(u2, t2);
   const dvec2 g{glm::dot(u1, cdir), glm::dot(u2, cdir)};
   // det B = (u1 x u2) . cdir = -(|a1 x a2| / dist^2) (h / dist) (n . n_geo):
   // from the height h, not from b00 b11 - b01 b10, which cancels for grazing
   // observers.
-  const double det = -glm::length(cr) / (cone.dist * cone.dist) * (h / cone.dist) *
-                     (glm::dot(cr, n) > 0.0 ? 1.0 : -1.0);
+  const double det = -f.cross_len * (h * inv_dist) * (inv_dist * inv_dist) * f.flip;
   // The cone is {v : v^T Q v <= 0}, Q = M^-T J M^-1 with M = [[B, 0], [g^T, 1]]
   // (columns: a1, a2, centre, all over dist, in this frame) and J =
   // diag(1, 1, -1) (Heitz 2017's cone matrix, in another frame). Q's entries are
@@ -473,16 +569,18 @@ inline ellipse_cone make_ellipse_cone(const ellipse& e, const vec3& o) {
   const int imaj = ev[i1] >= ev[i2] ? i1 : i2, imin = imaj == i1 ? i2 : i1;
   const double pneg = ev[in], pmaj = ev[imaj], pmin = ev[imin];
   if (!(pneg < 0.0 && pmin > 0.0)) return cone;
-  cone.se.a = std::sqrt(-pmaj / pneg);
-  cone.se.b = std::sqrt(-pmin / pneg);
+  const double inv_neg = -1.0 / pneg;
+  cone.se.a = std::sqrt(pmaj * inv_neg);
+  cone.se.b = std::sqrt(pmin * inv_neg);
   if constexpr (Frame) {
     cone.cdir = cdir;
     cone.t1 = t1;
     cone.t2 = t2;
-    cone.r00 = b11 / det;
-    cone.r01 = -b01 / det;
-    cone.r10 = -b10 / det;
-    cone.r11 = b00 / det;
+    const double inv_det = 1.0 / det;
+    cone.r00 = b11 * inv_det;
+    cone.r01 = -b01 * inv_det;
+    cone.r10 = -b10 * inv_det;
+    cone.r11 = b00 * inv_det;
     cone.k = {cone.r00 * g.x + cone.r10 * g.y, cone.r01 * g.x + cone.r11 * g.y};  // R^T g
     auto column = [&](int j) { return dvec3(vec[0][j], vec[1][j], vec[2][j]); };
     cone.ez = column(in);
@@ -498,18 +596,24 @@ inline ellipse_cone make_ellipse_cone(const ellipse& e, const vec3& o) {
   cone.mode = ellipse_cone_mode::spherical;
   return cone;
 }
+template <class Solver = newton_carlson_solver, bool Frame = true>
+inline ellipse_cone make_ellipse_cone(const ellipse& e, const vec3& o) {
+  return make_ellipse_cone<Solver, Frame>(e, ellipse_frame(e), o);
+}
 
 // Light-sampling strategy: uniform in the solid angle of the ellipse from o
 // (one-sided: nothing behind), through the parallel map of the spherical
 // ellipse; area sampling with its exact pdf where the map is unreliable.
 template <class Solver = newton_carlson_solver>
 struct basic_ellipse_solid_angle_sampler {
-  ellipse shape;
+  ellipse shape;  // fixed after construction (frame_ is derived from it)
+
+  explicit basic_ellipse_solid_angle_sampler(const ellipse& e) : shape(e), frame_(e) {}
 
   bool faces(const vec3& o) const { return shape.faces(o); }
 
   bool sample(const vec3& o, vec2 u, light_sample& s) const {
-    const ellipse_cone cone = make_ellipse_cone<Solver>(shape, o);
+    const ellipse_cone cone = make_ellipse_cone<Solver>(shape, frame_, o);
     if (cone.mode == ellipse_cone_mode::none) return false;
     if (cone.mode == ellipse_cone_mode::area) return ellipse_area_sampler{shape}.sample(o, u, s);
     const dvec2 p = square_to_spherical_ellipse<Solver>(dvec2(u), cone.se, cone.omega);
@@ -526,19 +630,22 @@ struct basic_ellipse_solid_angle_sampler {
   }
 
   // Density per unit SOLID ANGLE at o of the unit direction dir.
+  // The ray test comes first: a direction that misses the light (most
+  // directions a BSDF samples) costs no cone set-up. Both branches below
+  // would test the same float ray against the same shape.
   float pdf(const vec3& o, const vec3& dir) const {
-    const ellipse_cone cone = make_ellipse_cone<Solver, false>(shape, o);
+    float t;
+    if (!shape.faces(o) || !shape.intersect({o, dir}, 0.0f, infinity, t)) return 0.0f;
+    const ellipse_cone cone = make_ellipse_cone<Solver, false>(shape, frame_, o);
     if (cone.mode == ellipse_cone_mode::none) return 0.0f;
     if (cone.mode == ellipse_cone_mode::area) return ellipse_area_sampler{shape}.pdf(o, dir);
-    float t;
-    if (!shape.intersect({o, dir}, 0.0f, infinity, t)) return 0.0f;
     return static_cast<float>(square_to_spherical_ellipse_pdf(cone.omega));
   }
 
   // The u that sample() maps to dir (dir must hit the ellipse); false where
   // sample() has no sample for o.
   bool invert(const vec3& o, const vec3& dir, vec2& u) const {
-    const ellipse_cone cone = make_ellipse_cone<Solver>(shape, o);
+    const ellipse_cone cone = make_ellipse_cone<Solver>(shape, frame_, o);
     if (cone.mode == ellipse_cone_mode::none) return false;
     if (cone.mode == ellipse_cone_mode::area) {
       float t;
@@ -551,6 +658,9 @@ struct basic_ellipse_solid_angle_sampler {
     u = vec2(spherical_ellipse_to_square<Solver>({p.x / p.z, p.y / p.z}, cone.se, cone.omega));
     return true;
   }
+
+ private:
+  ellipse_frame frame_;
 };
 
 using ellipse_solid_angle_sampler = basic_ellipse_solid_angle_sampler<>;
