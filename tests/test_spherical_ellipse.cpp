@@ -387,6 +387,30 @@ TEST(SphericalEllipse, SolverResidual) {
   RecordProperty("worst_newton_residual", std::to_string(worst_newton));
   RecordProperty("worst_seed_residual", std::to_string(worst_seed));
 }
+
+// The Newton solver over random cones: tangents a log-uniform in [1e-4, 1e3],
+// axis ratios log-uniform in [1, 1e4], u1 uniform. Most of its steps update
+// the residual by local Gauss-Legendre quadrature instead of the closed
+// form (see newton_carlson_solver::invert); the residual checked here is
+// the independent adaptive quadrature's, so an error of those local
+// updates would show. Bound: the solver's tolerance 1e-9 plus 5e-10 for the
+// local rules and the reference quadrature (1e-12 relative each).
+TEST(SphericalEllipse, SolverResidualRandomCones) {
+  pcg32 rng(2024, 5);
+  double worst = 0.0;
+  for (int i = 0; i < 3000; ++i) {
+    const double a = std::pow(10.0, -4.0 + 7.0 * rng.uniform());
+    const double ratio = std::pow(10.0, 4.0 * rng.uniform());
+    const spherical_ellipse se{a, a / ratio};
+    const double omega = spherical_ellipse_area(se);
+    const double u = rng.uniform();
+    const spherical_ellipse_slice sl = newton_carlson_solver::invert(se, omega, u);
+    const double res = std::abs(partial_area_quadrature(se, std::atan2(sl.s, sl.c)) - u * omega) / omega;
+    worst = std::max(worst, res);
+    ASSERT_LE(res, 1.5e-9) << "a " << a << " b " << a / ratio << " u " << u;
+  }
+  RecordProperty("worst_residual", std::to_string(worst));
+}
 #endif
 
 // Fallback: the decision depends on (ellipse, observer) only and the area

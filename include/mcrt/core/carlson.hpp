@@ -50,6 +50,19 @@ inline double carlson_rc(double x, double y) {
   return std::atanh(t) / std::sqrt(x - y);
 }
 
+// R_C(1, 1 + e), e > -1, the form the R_J loops below need: for |e| < 1e-2
+// the series atan(sqrt(e)) / sqrt(e) = sum_k (-e)^k / (2k + 1) to e^8
+// (truncation below 1e-19), with neither division nor square root; the
+// closed forms of carlson_rc otherwise.
+inline double carlson_rc1(double e) {
+  if (std::abs(e) < 1e-2) {
+    double r = 1.0 / 17.0;
+    for (int k = 7; k >= 0; --k) r = 1.0 / (2 * k + 1) - e * r;
+    return r;
+  }
+  return carlson_rc(1.0, 1.0 + e);
+}
+
 // R_F(x, y, z) = 1/2 int_0^inf ((t + x)(t + y)(t + z))^(-1/2) dt; x, y, z >= 0,
 // at most one of them 0 (Carlson 1995, alg. 1).
 inline double carlson_rf(double x, double y, double z) {
@@ -89,7 +102,7 @@ inline double carlson_rj(double x, double y, double z, double p) {
     const double lambda = sx * (sy + sz) + sy * sz;
     const double d = (sp + sx) * (sp + sy) * (sp + sz);
     const double e = delta * (scale * scale * scale) / (d * d);
-    sum += scale * carlson_rc(1.0, 1.0 + e) / d;
+    sum += scale * carlson_rc1(e) / d;
     x = 0.25 * (x + lambda);
     y = 0.25 * (y + lambda);
     z = 0.25 * (z + lambda);
@@ -126,7 +139,7 @@ inline void carlson_rf_rj(double x, double y, double z, double p, double& rf, do
     const double lambda = sx * (sy + sz) + sy * sz;
     const double d = (sp + sx) * (sp + sy) * (sp + sz);
     const double e = delta * (scale * scale * scale) / (d * d);
-    sum += scale * carlson_rc(1.0, 1.0 + e) / d;
+    sum += scale * carlson_rc1(e) / d;
     x = 0.25 * (x + lambda);
     y = 0.25 * (y + lambda);
     z = 0.25 * (z + lambda);

@@ -166,8 +166,9 @@ struct newton_carlson_solver {
   }
 
   // The slice with Omega_p = u1 Omega; `iterations` (optional) reports the
-  // number of Newton or bisection steps taken (closed-form evaluations plus
-  // local quadratures, see below).
+  // number of residuals examined: the closed-form one at the start, then one
+  // per Newton, Halley or bisection step (by closed form or by local
+  // quadrature, see below).
   static spherical_ellipse_slice invert(const spherical_ellipse& se, double omega, double u1,
                                         int* iterations = nullptr) {
     using fast_math::sincos_quadrant;
@@ -228,6 +229,17 @@ struct newton_carlson_solver {
       (f < 0.0 ? lo : hi) = psi;
       const double fp = spherical_ellipse_slice_density(se, sl);
       double next = psi - f / fp;
+      if (std::abs(next - psi) <= local && sl.c > 1e-3) {
+        // A local step: Halley's instead of Newton's (cubic convergence),
+        // d = d_N / (1 + d_N L / 2) with L = f'' / f' the log-derivative of
+        // the slice density (see below); its residual is integrated, not
+        // bounded, so any step inside the bracket is safe.
+        const double a2 = se.a * se.a, b2 = se.b * se.b, s2 = sl.s * sl.s, c2 = sl.c * sl.c;
+        const double lg = -2.0 * sl.s / sl.c - 2.0 * b2 * sl.s * sl.c / (1.0 + b2 * s2) +
+                          (a2 - b2) * sl.s * sl.c / (1.0 + a2 * c2 + b2 * s2);
+        const double dn = next - psi;
+        next = psi + dn / (1.0 + 0.5 * dn * lg);
+      }
       const bool newton = next > lo && next < hi;
       if (!newton) next = 0.5 * (lo + hi);
       if (next == psi) break;  // the bracket is down to one ulp
