@@ -340,6 +340,47 @@ class cell_integrator {
   std::size_t evals_ = 0;
 };
 
+// Pearson's statistic with Mitsuba's pooling (math::chi2): cells in
+// increasing order of expected count; cells below chi2_pool_threshold are
+// accumulated until the pool reaches it. Empty cells that expect nothing are
+// skipped. bins is the number of terms of the statistic.
+inline void pooled_statistic(const std::vector<double>& observed, const std::vector<double>& expected, double& stat,
+                             int& bins, std::size_t& pooled_in, std::size_t& pooled_out,
+                             std::size_t& zero_expected_hit) {
+  const std::size_t cells = observed.size();
+  std::vector<std::size_t> order(cells);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t i, std::size_t j) { return expected[i] < expected[j]; });
+  stat = 0.0;
+  bins = 0;
+  pooled_in = pooled_out = zero_expected_hit = 0;
+  double pool_obs = 0.0, pool_exp = 0.0;
+  for (const std::size_t c : order) {
+    const double o = observed[c], e = expected[c];
+    if (e == 0.0 && o == 0.0) continue;
+    if (e == 0.0) ++zero_expected_hit;
+    if (e < chi2_pool_threshold || pool_exp > 0.0 || pool_obs > 0.0) {
+      pool_obs += o;
+      pool_exp += e;
+      ++pooled_in;
+      if (pool_exp >= chi2_pool_threshold) {
+        stat += sqr(pool_obs - pool_exp) / pool_exp;
+        pool_obs = pool_exp = 0.0;
+        ++pooled_out;
+        ++bins;
+      }
+    } else {
+      stat += sqr(o - e) / e;
+      ++bins;
+    }
+  }
+  if (pool_exp > 0.0 && bins == 0) {  // everything expects fewer than 5 samples
+    stat += sqr(pool_obs - pool_exp) / pool_exp;
+    ++bins;
+  }
+}
+
 inline std::string format_direction(const dvec3& d) {
   std::ostringstream s;
   s.precision(9);
@@ -499,39 +540,11 @@ chi2_result chi2_test_directions(Sample&& sample, Pdf&& pdf, const dvec3& axis, 
   }
   res.pdf_integral = mass;
 
-  // ---- pooling (Mitsuba's math::chi2): cells in increasing order of
-  // expected count; cells below the threshold are accumulated until the pool
-  // reaches it. Empty cells that expect nothing are skipped.
-  std::vector<std::size_t> order(cells);
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t i, std::size_t j) { return expected[i] < expected[j]; });
-  double stat = 0.0, pool_obs = 0.0, pool_exp = 0.0;
+  // ---- pooling and the statistic
+  double stat = 0.0;
   int bins = 0;
   std::size_t pooled_in = 0, pooled_out = 0, zero_expected_hit = 0;
-  for (const std::size_t c : order) {
-    const double o = observed[c], e = expected[c];
-    if (e == 0.0 && o == 0.0) continue;
-    if (e == 0.0) ++zero_expected_hit;
-    if (e < chi2_pool_threshold || pool_exp > 0.0 || pool_obs > 0.0) {
-      pool_obs += o;
-      pool_exp += e;
-      ++pooled_in;
-      if (pool_exp >= chi2_pool_threshold) {
-        stat += sqr(pool_obs - pool_exp) / pool_exp;
-        pool_obs = pool_exp = 0.0;
-        ++pooled_out;
-        ++bins;
-      }
-    } else {
-      stat += sqr(o - e) / e;
-      ++bins;
-    }
-  }
-  if (pool_exp > 0.0 && bins == 0) {  // everything expects fewer than 5 samples
-    stat += sqr(pool_obs - pool_exp) / pool_exp;
-    ++bins;
-  }
+  detail::pooled_statistic(observed, expected, stat, bins, pooled_in, pooled_out, zero_expected_hit);
   res.statistic = stat;
   res.dof = bins - 1;
   res.p_value = res.dof >= 1 ? chi2_survival(stat, res.dof) : 0.0;
@@ -607,6 +620,143 @@ chi2_result chi2_test_directions(Sample&& sample, Pdf&& pdf, const dvec3& axis, 
         << (ip + 1) * dphi * 180.0 / pi << "]: " << observed[c] << " vs " << expected[c] << ", " << contribution(c)
         << "\n";
   }
+  res.report = rep.str();
+  return res;
+}
+
+// The same test on the light's own parameter square instead of directions:
+// for slivers (grazing views, thin ellipses) and tiny lights, whose cones are
+// far narrower than any cell of a direction grid can resolve, while the
+// light itself, parametrized by its uniform-area map, is a plain square.
+//   sample:  bool(pcg32& rng, dvec2& uv), the unit-square coordinates (by
+//            the light's area map) of the point a sample hits, computed in
+//            double from the sampler's double internals;
+//   density: double(const dvec2& uv), the density the sampler claims, per
+//            unit of uv: its pdf per unit solid angle times the solid angle
+//            per unit uv (A |cos| / d^2 for an area-uniform map).
+// Expected counts by tensor Gauss-Legendre (8 x 8 nodes) on each cell,
+// refined into quarters until two levels agree to 1e-7 of the cell's mass
+// (the density is smooth on the light away from the observer's foot, which
+// the configurations keep at a distance). The density's integral over the
+// square must be 1 within chi2_mass_tolerance: with the solid angle
+// computed by the sampler, this checks that solid angle too. Same pooling,
+// significance and failure rules as chi2_test_directions.
+template <class Sample, class Density>
+chi2_result chi2_test_unit_square(Sample&& sample, Density&& density, const chi2_options& opt = {}) {
+  chi2_result res;
+  std::ostringstream rep;
+  rep.precision(6);
+  int n = opt.res_theta > 0 ? opt.res_theta
+                            : std::clamp(static_cast<int>(std::lround(std::sqrt(opt.sample_count / 100.0))) | 1, 3, 1001);
+  const std::size_t cells = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+  const double du = 1.0 / n;
+
+  std::vector<double> observed(cells, 0.0);
+  pcg32 rng(opt.seed, 0x5851f42d4c957f2dULL);
+  std::size_t n_false = 0, n_outside = 0;
+  dvec2 first_outside{0.0};
+  for (std::size_t i = 0; i < opt.sample_count; ++i) {
+    dvec2 uv;
+    if (!sample(rng, uv)) {
+      ++n_false;
+      continue;
+    }
+    if (!(uv.x >= 0.0 && uv.x <= 1.0 && uv.y >= 0.0 && uv.y <= 1.0)) {
+      if (n_outside++ == 0) first_outside = uv;
+      continue;
+    }
+    const int iu = std::min(static_cast<int>(uv.x * n), n - 1), iv = std::min(static_cast<int>(uv.y * n), n - 1);
+    observed[static_cast<std::size_t>(iu) * n + iv] += 1.0;
+  }
+
+  // 8-point Gauss-Legendre nodes and weights on [-1, 1].
+  static constexpr double gx[4] = {0.18343464249564980494, 0.52553240991632898582, 0.79666647741362673959,
+                                   0.96028985649753623168};
+  static constexpr double gw[4] = {0.36268378337836198297, 0.31370664587788728734, 0.22238103445337447054,
+                                   0.10122853629037625915};
+  bool bad = false;
+  dvec2 bad_at{0.0};
+  double bad_value = 0.0;
+  const auto rule = [&](double u0, double u1, double v0, double v1) {
+    const double hu = 0.5 * (u1 - u0), hv = 0.5 * (v1 - v0), cu = u0 + hu, cv = v0 + hv;
+    double sum = 0.0;
+    for (int i = 0; i < 8; ++i) {
+      const double xu = cu + (i < 4 ? -gx[i] : gx[i - 4]) * hu, wu = gw[i < 4 ? i : i - 4];
+      for (int j = 0; j < 8; ++j) {
+        const double xv = cv + (j < 4 ? -gx[j] : gx[j - 4]) * hv, wv = gw[j < 4 ? j : j - 4];
+        const double f = density(dvec2(xu, xv));
+        if (!(f >= 0.0) || !std::isfinite(f)) {
+          if (!bad) bad_at = {xu, xv}, bad_value = f;
+          bad = true;
+          continue;
+        }
+        sum += wu * wv * f;
+      }
+    }
+    return sum * hu * hv;
+  };
+  const auto adaptive = [&](auto&& self, double u0, double u1, double v0, double v1, double whole, int depth) -> double {
+    const double um = 0.5 * (u0 + u1), vm = 0.5 * (v0 + v1);
+    const double q[4] = {rule(u0, um, v0, vm), rule(um, u1, v0, vm), rule(u0, um, vm, v1), rule(um, u1, vm, v1)};
+    const double parts = q[0] + q[1] + q[2] + q[3];
+    if (depth >= 8 || std::abs(parts - whole) <= 1e-7 * std::abs(parts) + 1e-16) return parts;
+    return self(self, u0, um, v0, vm, q[0], depth + 1) + self(self, um, u1, v0, vm, q[1], depth + 1) +
+           self(self, u0, um, vm, v1, q[2], depth + 1) + self(self, um, u1, vm, v1, q[3], depth + 1);
+  };
+  std::vector<double> expected(cells, 0.0);
+  double mass = 0.0;
+  for (int iu = 0; iu < n; ++iu)
+    for (int iv = 0; iv < n; ++iv) {
+      const double u0 = iu * du, u1 = (iu + 1) * du, v0 = iv * du, v1 = (iv + 1) * du;
+      const double m = adaptive(adaptive, u0, u1, v0, v1, rule(u0, u1, v0, v1), 0);
+      mass += m;
+      expected[static_cast<std::size_t>(iu) * n + iv] = m * static_cast<double>(opt.sample_count);
+    }
+  res.pdf_integral = mass;
+
+  double stat = 0.0;
+  int bins = 0;
+  std::size_t pooled_in = 0, pooled_out = 0, zero_expected_hit = 0;
+  detail::pooled_statistic(observed, expected, stat, bins, pooled_in, pooled_out, zero_expected_hit);
+  res.statistic = stat;
+  res.dof = bins - 1;
+  res.p_value = res.dof >= 1 ? chi2_survival(stat, res.dof) : 0.0;
+  const double alpha = chi2_per_test_significance();
+
+  bool ok = true;
+  if (n_false > 0) {
+    ok = false;
+    rep << "FAIL: sample() returned false for " << n_false << " of " << opt.sample_count << " samples\n";
+  }
+  if (n_outside > 0) {
+    ok = false;
+    rep << "FAIL: " << n_outside << " samples fall outside the unit square, first (" << first_outside.x << ", "
+        << first_outside.y << ")\n";
+  }
+  if (bad) {
+    ok = false;
+    rep << "FAIL: density negative or not finite at (" << bad_at.x << ", " << bad_at.y << "): " << bad_value << "\n";
+  }
+  if (!(std::abs(mass - 1.0) <= chi2_mass_tolerance)) {
+    ok = false;
+    rep << "FAIL: the density integrates to " << mass << " over the square, not 1\n";
+  }
+  if (res.dof < 1) {
+    ok = false;
+    rep << "FAIL: too few degrees of freedom (" << res.dof << ")\n";
+  }
+  if (!(res.p_value >= alpha)) {
+    ok = false;
+    rep << "FAIL: null hypothesis rejected, p-value " << res.p_value << " < " << alpha << "\n";
+  }
+  res.passed = ok;
+  rep << (ok ? "passed" : "failed") << ": chi2 = " << stat << ", dof = " << res.dof << ", p-value = " << res.p_value
+      << " (level " << alpha << "), grid " << n << " x " << n << " on the light's square, " << opt.sample_count
+      << " samples, density integral " << mass << "\n";
+  if (pooled_in > 0)
+    rep << "pooled " << pooled_in << " cells expecting < " << chi2_pool_threshold << " samples into " << pooled_out
+        << " bins\n";
+  if (zero_expected_hit > 0) rep << zero_expected_hit << " cells with integrated density 0 received samples (pooled)\n";
   res.report = rep.str();
   return res;
 }
