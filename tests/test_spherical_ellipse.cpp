@@ -27,6 +27,7 @@
 
 #include "mcrt/core/rng.hpp"
 #include "mcrt/sampling/spherical_ellipse.hpp"
+#include "mcrt/sampling/spherical_ellipse_polar.hpp"
 #include "support/chi2.hpp"
 #include "support/solid_angle.hpp"
 
@@ -322,9 +323,11 @@ std::vector<ellipse_case> surface_chi2_battery() {
   return out;
 }
 
-template <class Solver>
-test::chi2_result surface_chi2(const ellipse_case& c, std::uint64_t seed, std::size_t count) {
-  const basic_ellipse_solid_angle_sampler<Solver> smp{c.shape};
+// Sampler: the strategy under test; map(u, se, omega): its map on the
+// canonical spherical ellipse; Solver: whose solid angle the cone carries.
+template <class Solver, class Sampler, class Map>
+test::chi2_result surface_chi2(const ellipse_case& c, std::uint64_t seed, std::size_t count, Map&& map) {
+  const Sampler smp{c.shape};
   const ellipse_cone cone = make_ellipse_cone<Solver>(c.shape, c.o);
   const ellipse_frame f(c.shape);
   const double area = dpi * f.cross_len;
@@ -335,7 +338,7 @@ test::chi2_result surface_chi2(const ellipse_case& c, std::uint64_t seed, std::s
     const vec2 u = rng.uniform2();
     dvec2 xe{0.0};
     if (cone.mode == ellipse_cone_mode::spherical) {
-      xe = cone.ellipse_coords(square_to_spherical_ellipse<Solver>(dvec2(u), cone.se, cone.omega));
+      xe = cone.ellipse_coords(map(dvec2(u), cone.se, cone.omega));
     } else if (cone.mode == ellipse_cone_mode::area) {
       const vec3 p = square_to_ellipse(u, c.shape);  // the fallback's map
       xe = {glm::dot(dvec3(p) - f.center, dvec3(c.shape.a1_dual)), glm::dot(dvec3(p) - f.center, dvec3(c.shape.a2_dual))};
@@ -370,10 +373,27 @@ test::chi2_result surface_chi2(const ellipse_case& c, std::uint64_t seed, std::s
   return r;
 }
 
+// The parallel map with solver Solver, as the sampler basic_ellipse_solid_angle_sampler<Solver>.
+template <class Solver>
+test::chi2_result parallel_surface_chi2(const ellipse_case& c, std::uint64_t seed, std::size_t count) {
+  return surface_chi2<Solver, basic_ellipse_solid_angle_sampler<Solver>>(
+      c, seed, count, [](dvec2 u, const spherical_ellipse& se, double omega) {
+        return square_to_spherical_ellipse<Solver>(u, se, omega);
+      });
+}
+
 class SphericalEllipseSurfaceChi2 : public ::testing::TestWithParam<ellipse_case> {};
 
 TEST_P(SphericalEllipseSurfaceChi2, Newton) {
-  const test::chi2_result r = surface_chi2<newton_carlson_solver>(GetParam(), 31, 200'000);
+  const test::chi2_result r = parallel_surface_chi2<newton_carlson_solver>(GetParam(), 31, 200'000);
+  EXPECT_TRUE(r.passed) << GetParam().name << "\n" << r.report;
+}
+
+TEST_P(SphericalEllipseSurfaceChi2, Polar) {
+  const test::chi2_result r = surface_chi2<newton_carlson_solver, ellipse_polar_solid_angle_sampler>(
+      GetParam(), 37, 200'000, [](dvec2 u, const spherical_ellipse& se, double omega) {
+        return square_to_spherical_ellipse_polar(u, se, omega);
+      });
   EXPECT_TRUE(r.passed) << GetParam().name << "\n" << r.report;
 }
 
@@ -390,8 +410,8 @@ struct warped_newton_solver : newton_carlson_solver {
 TEST(SphericalEllipseSurfaceChi2Power, RejectsWrongSamplers) {
   for (const ellipse_case& c : battery()) {
     if (c.name != "ratio_1e3_grazing" && c.name != "ratio_1e4") continue;
-    EXPECT_FALSE((surface_chi2<warped_newton_solver>(c, 31, 200'000).passed)) << c.name;
-    EXPECT_FALSE((surface_chi2<bisection_simpson_solver>(c, 31, 200'000).passed)) << c.name;
+    EXPECT_FALSE((parallel_surface_chi2<warped_newton_solver>(c, 31, 200'000).passed)) << c.name;
+    EXPECT_FALSE((parallel_surface_chi2<bisection_simpson_solver>(c, 31, 200'000).passed)) << c.name;
   }
 }
 

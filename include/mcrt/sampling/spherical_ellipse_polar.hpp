@@ -292,12 +292,14 @@ inline dvec2 spherical_ellipse_polar_to_square(dvec2 p, const spherical_ellipse&
 // the spherical set-up is unreliable (the same fallbacks, thresholds and
 // solid angle as basic_ellipse_solid_angle_sampler).
 struct ellipse_polar_solid_angle_sampler {
-  ellipse shape;
+  ellipse shape;  // fixed after construction (frame_ is derived from it)
+
+  explicit ellipse_polar_solid_angle_sampler(const ellipse& e) : shape(e), frame_(e) {}
 
   bool faces(const vec3& o) const { return shape.faces(o); }
 
   bool sample(const vec3& o, vec2 u, light_sample& s) const {
-    const ellipse_cone cone = make_ellipse_cone(shape, o);
+    const ellipse_cone cone = make_ellipse_cone(shape, frame_, o);
     if (cone.mode == ellipse_cone_mode::none) return false;
     if (cone.mode == ellipse_cone_mode::area) return ellipse_area_sampler{shape}.sample(o, u, s);
     const dvec2 p = square_to_spherical_ellipse_polar(dvec2(u), cone.se, cone.omega);
@@ -315,20 +317,22 @@ struct ellipse_polar_solid_angle_sampler {
     return std::isfinite(s.pdf) && s.pdf > 0.0f && all_finite(s.dir);
   }
 
-  // Density per unit SOLID ANGLE at o of the unit direction dir.
+  // Density per unit SOLID ANGLE at o of the unit direction dir. The ray
+  // test comes first, as in basic_ellipse_solid_angle_sampler: a direction
+  // that misses costs no cone set-up.
   float pdf(const vec3& o, const vec3& dir) const {
-    const ellipse_cone cone = make_ellipse_cone<newton_carlson_solver, false>(shape, o);
+    float t;
+    if (!shape.faces(o) || !shape.intersect({o, dir}, 0.0f, infinity, t)) return 0.0f;
+    const ellipse_cone cone = make_ellipse_cone<newton_carlson_solver, false>(shape, frame_, o);
     if (cone.mode == ellipse_cone_mode::none) return 0.0f;
     if (cone.mode == ellipse_cone_mode::area) return ellipse_area_sampler{shape}.pdf(o, dir);
-    float t;
-    if (!shape.intersect({o, dir}, 0.0f, infinity, t)) return 0.0f;
     return static_cast<float>(square_to_spherical_ellipse_polar_pdf(cone.omega));
   }
 
   // The u that sample() maps to dir (dir must hit the ellipse); false where
   // sample() has no sample for o.
   bool invert(const vec3& o, const vec3& dir, vec2& u) const {
-    const ellipse_cone cone = make_ellipse_cone(shape, o);
+    const ellipse_cone cone = make_ellipse_cone(shape, frame_, o);
     if (cone.mode == ellipse_cone_mode::none) return false;
     if (cone.mode == ellipse_cone_mode::area) {
       float t;
@@ -341,6 +345,9 @@ struct ellipse_polar_solid_angle_sampler {
     u = vec2(spherical_ellipse_polar_to_square({p.x / p.z, p.y / p.z}, cone.se, cone.omega));
     return true;
   }
+
+ private:
+  ellipse_frame frame_;
 };
 
 }  // namespace mcrt
