@@ -17,7 +17,7 @@ using namespace mcrt;
 using namespace mcrt::cli;
 
 struct render_options {
-  std::string scene, output, stats, light_sampling;
+  std::string scene, output, stats, light_sampling, ellipse_map = "parallel";
   std::optional<int> spp, width, height, max_depth, rr_depth;
   std::optional<unsigned> threads;
   std::uint64_t seed = 0;
@@ -47,7 +47,8 @@ std::string strategy_summary(const scene& world) {
           using S = std::decay_t<decltype(s)>;
           if constexpr (std::is_same_v<S, rect_area_sampler> || std::is_same_v<S, ellipse_area_sampler>)
             area = true;
-          else if constexpr (std::is_same_v<S, rect_solid_angle_sampler> || std::is_same_v<S, ellipse_solid_angle_sampler>)
+          else if constexpr (std::is_same_v<S, rect_solid_angle_sampler> || std::is_same_v<S, ellipse_solid_angle_sampler> ||
+                             std::is_same_v<S, ellipse_polar_solid_angle_sampler>)
             sa = true;  // spheres have one strategy only and do not count
         },
         l);
@@ -73,7 +74,8 @@ int run_render(const render_options& opt) {
   if (!opt.light_sampling.empty())
     strategy = opt.light_sampling == "area" ? light_sampling::area : light_sampling::solid_angle;
 
-  loaded_scene ls = load_scene(opt.scene, strategy);
+  const cli::ellipse_map map = opt.ellipse_map == "polar" ? cli::ellipse_map::polar : cli::ellipse_map::parallel;
+  loaded_scene ls = load_scene(opt.scene, strategy, map);
   const std::string output = opt.output.empty() ? ls.name + ".exr" : opt.output;
   check_writable(output, true);
   if (!opt.stats.empty()) check_writable(opt.stats, false);
@@ -103,6 +105,7 @@ int run_render(const render_options& opt) {
                {"mcrt:spp", "", static_cast<double>(rs.spp), true, true},
                {"mcrt:seed", std::to_string(rs.seed)},
                {"mcrt:light_sampling", strategy_used},
+               {"mcrt:ellipse_map", opt.ellipse_map},
                {"mcrt:scene", ls.name}});
   if (!opt.stats.empty()) {
     nlohmann::ordered_json j;
@@ -113,6 +116,7 @@ int run_render(const render_options& opt) {
     j["threads"] = res.threads;
     j["samples_per_second"] = samples / res.seconds;
     j["light_sampling"] = strategy_used;
+    j["ellipse_map"] = opt.ellipse_map;
     j["seed"] = rs.seed;
     j["max_depth"] = rs.max_depth;
     j["rr_depth"] = rs.rr_depth;
@@ -176,6 +180,9 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--threads", ro.threads, "Threads (default: all hardware threads)");
   render_cmd->add_option("--light-sampling", ro.light_sampling, "Sample every light by area or solid angle")
       ->check(CLI::IsMember({"area", "solid-angle"}));
+  render_cmd->add_option("--ellipse-map", ro.ellipse_map,
+                         "Map of the spherical ellipse for ellipses sampled by solid angle (default parallel)")
+      ->check(CLI::IsMember({"parallel", "polar"}));
   render_cmd->add_option("--stats", ro.stats, "Write render statistics as JSON to this file");
   render_cmd->add_flag("--quiet", ro.quiet, "No progress line");
 

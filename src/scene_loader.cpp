@@ -201,25 +201,29 @@ std::pair<float, float> interval(const reader& rd, const json& o, const std::str
 }
 
 // Adds the light (or importance target) for a shape, with its strategy.
-void add_light(scene& world, const rect& s, light_sampling strategy) {
+void add_light(scene& world, const rect& s, light_sampling strategy, ellipse_map) {
   if (strategy == light_sampling::area)
     world.lights.emplace_back(rect_area_sampler{s});
   else
     world.lights.emplace_back(rect_solid_angle_sampler{s});
 }
-void add_light(scene& world, const ellipse& s, light_sampling strategy) {
+void add_light(scene& world, const ellipse& s, light_sampling strategy, ellipse_map map) {
   if (strategy == light_sampling::area)
     world.lights.emplace_back(ellipse_area_sampler{s});
+  else if (map == ellipse_map::polar)
+    world.lights.emplace_back(ellipse_polar_solid_angle_sampler{s});
   else
     world.lights.emplace_back(ellipse_solid_angle_sampler{s});
 }
 // A sphere is sampled by its cone of directions (uniform in solid angle)
 // under either strategy: there is no area strategy for spheres.
-void add_light(scene& world, const sphere& s, light_sampling) { world.lights.emplace_back(sphere_cone_sampler{s}); }
+void add_light(scene& world, const sphere& s, light_sampling, ellipse_map) {
+  world.lights.emplace_back(sphere_cone_sampler{s});
+}
 
 void read_object(const reader& rd, const json& o, const std::string& path, scene& world,
                  const std::map<std::string, std::uint32_t>& material_ids,
-                 std::optional<light_sampling> override_strategy) {
+                 std::optional<light_sampling> override_strategy, ellipse_map map) {
   if (!o.is_object()) rd.ctx.fail(path, std::string("expected an object, got ") + type_name(o));
   std::string type = rd.string(o, path, "type");
   const std::string mat_name = rd.string(o, path, "material");
@@ -241,7 +245,7 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
 
   auto add = [&](const auto& shape) {
     world.add(shape, mat);
-    if (sampled) add_light(world, shape, strategy);
+    if (sampled) add_light(world, shape, strategy, map);
   };
 
   if (type == "xz_rect" || type == "xy_rect" || type == "yz_rect") {
@@ -286,7 +290,7 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
 
 }  // namespace
 
-loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy) {
+loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy, ellipse_map map) {
   const context ctx{path};
   const reader rd{ctx};
   std::ifstream in(path, std::ios::binary);
@@ -338,7 +342,7 @@ loaded_scene load_scene(const std::string& path, std::optional<light_sampling> o
   if (!objs.is_array()) ctx.fail("objects", std::string("expected an array, got ") + type_name(objs));
   if (objs.empty()) ctx.fail("objects", "the scene has no objects");
   for (std::size_t i = 0; i < objs.size(); ++i)
-    read_object(rd, objs[i], "objects[" + std::to_string(i) + "]", out.world, ids, override_strategy);
+    read_object(rd, objs[i], "objects[" + std::to_string(i) + "]", out.world, ids, override_strategy, map);
 
   // Self-intersection guard proportional to the scene's coordinates: a few
   // thousand float ulps of the largest coordinate (1.1e-3 for the 555-unit

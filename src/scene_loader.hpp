@@ -33,7 +33,14 @@ struct loaded_scene {
   int spp = 100, max_depth = 50;
 };
 
+// Which area-preserving map of the spherical ellipse samples an ellipse by
+// solid angle (Guillen et al. 2017): the parallel one, as the seed, or the
+// polar one.
+enum class ellipse_map { parallel, polar };
+
 // override_strategy: --light-sampling; switches every light to one strategy.
-loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy = std::nullopt);
+// map: --ellipse-map; the map of every ellipse sampled by solid angle.
+loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy = std::nullopt,
+                        ellipse_map map = ellipse_map::parallel);
 
 }  // namespace mcrt::cli

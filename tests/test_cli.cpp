@@ -199,6 +199,7 @@ TEST_F(Cli, BadCommandLines) {
   expect_bad(base + "--width 20000", {"--width", "16384"}, out);
   expect_bad(base + "--threads 0", {"--threads"}, out);
   expect_bad(base + "--light-sampling sideways", {"--light-sampling"}, out);
+  expect_bad(base + "--ellipse-map round", {"--ellipse-map"}, out);
   expect_bad(base + "--no-such-flag", {"no-such-flag"}, out);
   expect_bad("render " + (dir / "missing.json").string() + " -o " + out.string(), {"missing.json"}, out);
   expect_bad("frobnicate", {"frobnicate"}, out);
@@ -273,5 +274,22 @@ TEST_F(Cli, EveryShippedSceneRenders) {
         EXPECT_EQ(j["nonfinite_samples"], 0) << e.path();
       }
     }
+  }
+}
+
+// --ellipse-map polar (an extension of the contract): the disk scenes render
+// with the polar map, and --stats says so; without ellipses it changes nothing.
+TEST_F(Cli, EllipseMapPolarRendersTheDiskScenes) {
+  for (const char* name : {"cornell_disk", "cornell_disk_large"}) {
+    const fs::path scene = fs::path(MCRT_SCENES_DIR) / (std::string(name) + ".json");
+    const fs::path out = dir / "polar.exr", stats = dir / "s.json";
+    const result r = run("render " + scene.string() + " -o " + out.string() +
+                         " --width 24 --height 24 --spp 2 --light-sampling solid-angle --ellipse-map polar --stats " +
+                         stats.string() + " --quiet");
+    ASSERT_EQ(r.status, 0) << name << ": " << r.err;
+    const auto j = nlohmann::json::parse(slurp(stats));
+    EXPECT_EQ(j["ellipse_map"], "polar");
+    EXPECT_EQ(j["light_sampling"], "solid-angle");
+    EXPECT_EQ(j["nonfinite_samples"], 0) << name;
   }
 }

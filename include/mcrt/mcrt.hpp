@@ -29,4 +29,7 @@
 #include "mcrt/sampling/light_sample.hpp"
 #include "mcrt/sampling/rect_area.hpp"
 #include "mcrt/sampling/sphere_cone.hpp"
+#include "mcrt/sampling/spherical_ellipse.hpp"
+#include "mcrt/sampling/spherical_ellipse_polar.hpp"
+#include "mcrt/sampling/spherical_rectangle.hpp"
 #include "mcrt/sampling/warp.hpp"

@@ -9,12 +9,13 @@
 #include "mcrt/sampling/rect_area.hpp"
 #include "mcrt/sampling/sphere_cone.hpp"
 #include "mcrt/sampling/spherical_ellipse.hpp"
+#include "mcrt/sampling/spherical_ellipse_polar.hpp"
 #include "mcrt/sampling/spherical_rectangle.hpp"
 
 namespace mcrt {
 
 using light = std::variant<rect_area_sampler, rect_solid_angle_sampler, ellipse_area_sampler,
-                           ellipse_solid_angle_sampler, sphere_cone_sampler>;
+                           ellipse_solid_angle_sampler, ellipse_polar_solid_angle_sampler, sphere_cone_sampler>;
 
 // The free functions light_pdf (render/pdf.hpp) calls: the strategy's own
 // members for a plain strategy, a static dispatch for the variant.
