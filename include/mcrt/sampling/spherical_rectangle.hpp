@@ -419,8 +419,9 @@ struct rect_solid_angle_sampler {
   // o does not face the light. The ray test comes first, so a direction
   // that misses (most directions a BSDF samples) costs no set-up.
   float pdf(const vec3& o, const vec3& dir) const {
-    if (!hits(o, dir)) return 0.0f;
-    const view v = fast_view(o);
+    view v = local_view(o);
+    if (!hits(v, dir)) return 0.0f;
+    classify(v);
     if (v.path == path_kind::none) return 0.0f;
     if (v.path == path_kind::exact) return pdf_exact(o, dir);
     return float(1.0 / v.solid_angle);
@@ -436,25 +437,8 @@ struct rect_solid_angle_sampler {
     double x0 = 0.0, x1 = 0.0, y0 = 0.0, y1 = 0.0, h = 0.0, solid_angle = 0.0, r00 = 0.0, r01 = 0.0;
   };
 
-  // The ray o + t dir against the rectangle, in double in the local frame,
-  // with the arithmetic of spherical_rectangle::intersect (same frame, same
-  // local coordinates), so both paths agree with it. Edges count as inside.
-  bool hits(const vec3& o, const vec3& dir) const {
-    const dvec3 d = dvec3(shape.corner) - dvec3(o);  // exact: a difference of floats in double
-    const double h = -glm::dot(d, ez_);
-    if (!(h > 0.0)) return false;  // behind or in the plane (also NaN)
-    const dvec3 dd(dir);
-    const double dz = glm::dot(dd, ez_);
-    if (!(dz < 0.0)) return false;  // parallel to the plane or going away from it
-    const double t = h / -dz;
-    const double x = t * glm::dot(dd, ex_), y = t * glm::dot(dd, ey_);
-    const double x0 = glm::dot(d, ex_), y0 = glm::dot(d, ey_);
-    return x >= x0 && x <= x0 + w_ && y >= y0 && y <= y0 + l_;
-  }
-
-  view fast_view(const vec3& o) const {
-    using namespace spherical_rectangle_detail;
-    using namespace fast_math;
+  // The local coordinates of o (h, x0, x1, y0, y1 of view); path none.
+  view local_view(const vec3& o) const {
     view v;
     const dvec3 d = dvec3(shape.corner) - dvec3(o);  // exact: a difference of floats in double
     v.h = -glm::dot(d, ez_);
@@ -462,14 +446,42 @@ struct rect_solid_angle_sampler {
     v.y0 = glm::dot(d, ey_);
     v.x1 = v.x0 + w_;
     v.y1 = v.y0 + l_;
+    return v;
+  }
+
+  // The ray o + t dir against the rectangle, in double in the local frame
+  // of v = local_view(o), with the arithmetic of spherical_rectangle::intersect
+  // (same frame, same local coordinates), so both paths agree with it.
+  // Edges count as inside.
+  bool hits(const view& v, const vec3& dir) const {
+    if (!(v.h > 0.0)) return false;  // behind or in the plane (also NaN)
+    const dvec3 dd(dir);
+    const double dz = glm::dot(dd, ez_);
+    if (!(dz < 0.0)) return false;  // parallel to the plane or going away from it
+    const double t = v.h / -dz;
+    const double x = t * glm::dot(dd, ex_), y = t * glm::dot(dd, ey_);
+    return x >= v.x0 && x <= v.x1 && y >= v.y0 && y <= v.y1;
+  }
+
+  view fast_view(const vec3& o) const {
+    view v = local_view(o);
+    classify(v);
+    return v;
+  }
+
+  // The path for the local coordinates in v, and on the fast path S and the
+  // corner distances.
+  void classify(view& v) const {
+    using namespace spherical_rectangle_detail;
+    using namespace fast_math;
     // Behind or in the plane (also NaN): no sample, as spherical_rectangle.
-    if (!(v.h > 0.0)) return v;
+    if (!(v.h > 0.0)) return;
     v.path = path_kind::exact;
     const double x0 = v.x0, x1 = v.x1, y0 = v.y0, y1 = v.y1, h2 = v.h * v.h;
     const double xx0 = x0 * x0, xx1 = x1 * x1, yy0 = y0 * y0, yy1 = y1 * y1;
     const double r00 = xx0 + yy0 + h2, r10 = xx1 + yy0 + h2, r11 = xx1 + yy1 + h2, r01 = xx0 + yy1 + h2;
     const double r_max2 = std::max(std::max(r00, r11), std::max(r10, r01));
-    if (!(h2 >= fast_min_sine * fast_min_sine * r_max2) || !(r_max2 <= 1e60 && h2 >= 1e-60)) return v;
+    if (!(h2 >= fast_min_sine * fast_min_sine * r_max2) || !(r_max2 <= 1e60 && h2 >= 1e-60)) return;
     // Van Oosterom-Strackee on the triangles (v00, v10, v11) and (v00, v11,
     // v01): the factor of each is r_a r_b r_c + (a.b) r_c + (a.c) r_b +
     // (b.c) r_a + i h w l, and S / 2 is the argument of their product (see
@@ -493,7 +505,6 @@ struct rect_solid_angle_sampler {
     if (z2 >= fast_min_vos_factor * fast_min_vos_factor &&
         s2 * h2 >= fast_min_solid_angle_sine * fast_min_solid_angle_sine * r_max2)
       v.path = path_kind::fast;
-    return v;
   }
 
   // UFK13 sec. 4 on the fast path, with the formulas (and notation) of
