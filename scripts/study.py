@@ -125,9 +125,11 @@ STRATEGY_STYLE = {
 SAMPLER_DESCRIPTIONS = {
     "BM_SampleRectArea": "rectangle, by area",
     "BM_SampleRectSolidAngle": "rectangle, by solid angle (spherical rectangle)",
+    "BM_SampleRectSolidAngleExact": "rectangle, by solid angle, exact path only",
     "BM_SampleEllipseArea": "disk/ellipse, by area",
-    "BM_SampleEllipseSolidAngle": "disk/ellipse, by solid angle",
-    "BM_SampleEllipseSolidAngleBisectionSimpson": "disk/ellipse, by solid angle (bisection + Simpson)",
+    "BM_SampleEllipseSolidAngle": "disk/ellipse, by solid angle (parallel map, Newton)",
+    "BM_SampleEllipseSolidAnglePolar": "disk/ellipse, by solid angle (polar map, Newton)",
+    "BM_SampleEllipseSolidAngleBisectionSimpson": "disk/ellipse, by solid angle (parallel map, the seed's bisection + Simpson)",
 }
 
 NOT_AVAILABLE_MARKER = "not available in this build"
@@ -1040,7 +1042,7 @@ def build_tables(rows: list[dict], settings: Settings, scenes: list[str],
         for s in samplers:
             shape = "Rect" if "Rect" in s["name"] else "Ellipse" if "Ellipse" in s["name"] else None
             base = area_ref.get(shape) if shape else None
-            srows.append([f"`{s['name']}`", s["description"], f"{s['cpu_ns']:.1f} ({s['real_ns']:.1f})",
+            srows.append([f"`{s['name']}`", SAMPLER_DESCRIPTIONS.get(s["name"], s["description"]), f"{s['cpu_ns']:.1f} ({s['real_ns']:.1f})",
                           fmt(s["cpu_ns"] / base, 3) if base else "–"])
         parts.append(md_table(["benchmark", "sampler", "ns per sample", "× area sampler"], srows, 2))
     else:

@@ -34,7 +34,10 @@
 // Two solvers of the area equation Omega_p = u1 Omega are policies:
 //   newton_carlson_solver      closed form above + safeguarded Newton in psi
 //                              (bracket, bisection fallback, planar initial
-//                              guess), residual <= 1e-9 Omega;
+//                              guess; later steps integrate the density over
+//                              the step by local Gauss-Legendre instead of
+//                              evaluating the closed form again), residual
+//                              <= 1e-9 Omega;
 //   bisection_simpson_solver   the seed's method (sec. 4.2, app. A.4): 10
 //                              bisection steps in theta, Omega_p by a
 //                              10-interval composite Simpson rule of 2 h_p.
@@ -229,7 +232,8 @@ struct newton_carlson_solver {
       (f < 0.0 ? lo : hi) = psi;
       const double fp = spherical_ellipse_slice_density(se, sl);
       double next = psi - f / fp;
-      if (std::abs(next - psi) <= local && sl.c > 1e-3) {
+      const bool halley = std::abs(next - psi) <= local && sl.c > 1e-3;
+      if (halley) {
         // A local step: Halley's instead of Newton's (cubic convergence),
         // d = d_N / (1 + d_N L / 2) with L = f'' / f' the log-derivative of
         // the slice density (see below); its residual is integrated, not
@@ -252,7 +256,10 @@ struct newton_carlson_solver {
       }
       psi = next;
       sincos_quadrant(psi, sl.s, sl.c);
-      if (newton && std::abs(step) * std::abs(spherical_ellipse_slice_density(se, sl) - fp) <= tolerance * omega)
+      // The bound holds for Newton steps only (a Halley step that ended up
+      // longer than `local` is checked by the closed form).
+      if (newton && !halley &&
+          std::abs(step) * std::abs(spherical_ellipse_slice_density(se, sl) - fp) <= tolerance * omega)
         break;
       f = spherical_ellipse_half_partial_area(se, sl) - goal;
     }
