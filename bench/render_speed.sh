@@ -6,7 +6,8 @@
 # Usage: bench/render_speed.sh [MCRT] [RUNS] [SCENE...]
 #   defaults: build/mcrt, 3 runs, scenes/cornell_book3.json
 # Environment: THREADS (default: all hardware threads), STRATEGY (area or
-# solid-angle; default: as each scene file says).
+# solid-angle; default: as each scene file says), ELLIPSE_MAP (parallel or
+# polar: the map of ellipses sampled by solid angle; default parallel).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 mcrt=${1:-build/mcrt}
@@ -17,6 +18,7 @@ scenes=("$@")
 threads=${THREADS:-$(nproc)}
 extra=()
 [ -n "${STRATEGY:-}" ] && extra=(--light-sampling "$STRATEGY")
+[ -n "${ELLIPSE_MAP:-}" ] && extra+=(--ellipse-map "$ELLIPSE_MAP")
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
