@@ -13,6 +13,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #ifdef MCRT_HAVE_BOOST_MATH
@@ -23,12 +24,11 @@
 #include <boost/math/special_functions/ellint_rj.hpp>
 #endif
 
-#include <glm/gtc/matrix_transform.hpp>
-
 #include "mcrt/core/rng.hpp"
 #include "mcrt/sampling/spherical_ellipse.hpp"
 #include "mcrt/sampling/spherical_ellipse_polar.hpp"
 #include "support/chi2.hpp"
+#include "support/ellipse_cases.hpp"
 #include "support/solid_angle.hpp"
 
 namespace {
@@ -37,68 +37,9 @@ using namespace mcrt;
 
 constexpr double dpi = std::numbers::pi;
 
-struct ellipse_case {
-  std::string name;
-  ellipse shape;
-  vec3 o;
-};
+using test::ellipse_case;
 
-// An ellipse with semi-axes r1, r2 in an arbitrary orientation (rotation by
-// `angle` about `axis`), observer at `o_local` in the ellipse's frame
-// (x along a1, y along a2, z along the front normal), shifted by `shift`.
-ellipse_case make_case(std::string name, float r1, float r2, vec3 o_local, vec3 axis = {0, 0, 1}, float angle = 0,
-                       vec3 shift = {0, 0, 0}, bool flip = false) {
-  const glm::mat3 rot = glm::mat3(glm::rotate(glm::mat4(1.0f), angle, glm::normalize(axis)));
-  const vec3 ex = rot * vec3(1, 0, 0), ey = rot * vec3(0, 1, 0), ez = rot * vec3(0, 0, 1);
-  ellipse_case c;
-  c.name = std::move(name);
-  c.shape = ellipse::make(shift, r1 * ex, r2 * ey, flip);
-  const vec3 front = flip ? -ez : ez;
-  c.o = shift + o_local.x * ex + o_local.y * ey + o_local.z * front;
-  return c;
-}
-
-// Normal and extreme configurations; the names say which.
-std::vector<ellipse_case> battery() {
-  const vec3 tilt{0.3f, -0.8f, 0.5f};
-  return {
-      make_case("disk_overhead", 1, 1, {0, 0, 2}),
-      make_case("disk_offaxis", 1, 1, {1.5f, 0.7f, 0.8f}, tilt, 0.7f, {3, -2, 5}),
-      make_case("ellipse_3to1_tilted", 3, 1, {0.5f, 2.0f, 1.5f}, tilt, 1.9f, {-1, 4, 2}),
-      make_case("ellipse_flipped", 2, 0.5f, {0.2f, 0.1f, 0.6f}, tilt, 2.4f, {0, 1, 0}, true),
-      make_case("disk_close_near_2pi", 1, 1, {0.1f, 0, 1e-3f}),
-      make_case("disk_far_offaxis", 1, 1, {60, 25, 1}),
-      make_case("disk_tiny_1em8sr", 5.64e-5f, 5.64e-5f, {0, 0, 1}),
-      make_case("disk_grazing_1em6", 1, 1, {3, 0, 3e-6f}),
-      make_case("disk_grazing_1em6_near_rim", 1, 1, {1.1f, 0, 1.1e-6f}),
-      make_case("ratio_1e2", 1, 1e-2f, {0.3f, 0.1f, 1}, tilt, 0.4f),
-      make_case("ratio_1e3", 1, 1e-3f, {0.3f, 0.1f, 1}, tilt, 1.1f),
-      make_case("ratio_1e4", 1, 1e-4f, {0.3f, 0.1f, 1}),
-      make_case("ratio_1e4_side", 1e-4f, 1, {0.3f, 0.1f, 1}),
-      make_case("ratio_1e3_grazing", 1, 1e-3f, {2, 0.5f, 1e-3f}),
-      make_case("ratio_1e4_grazing_fallback", 1e-4f, 1, {0, 2, 1e-4f}),
-      make_case("ratio_1e4_tiny_1em8sr", 5.64e-3f, 5.64e-7f, {0.3f, 0.7f, 0.8f}),
-  };
-}
-
-// Density claimed by sampler S in double: the same mode decision, then 1/Omega
-// on the ellipse (a double hit test) or the area density.
-template <class Solver>
-double pdf_double(const ellipse& e, const vec3& o, const dvec3& dir) {
-  const ellipse_cone cone = make_ellipse_cone<Solver>(e, o);
-  if (cone.mode == ellipse_cone_mode::none) return 0.0;
-  const dvec3 n(e.n), od(o), c(e.center);
-  const double h = glm::dot(od - c, n), den = -glm::dot(dir, n);
-  if (!(den > 0.0)) return 0.0;
-  const double t = h / den;
-  const dvec3 q = od + t * dir - c;
-  const double x = glm::dot(q, dvec3(e.a1_dual)), y = glm::dot(q, dvec3(e.a2_dual));
-  // 1e-5 of slack in r^2: a float direction sampled on the rim can round
-  // to just outside it (the mass of that band is ~1e-5 of the light's).
-  if (x * x + y * y > 1.0 + 1e-5) return 0.0;
-  if (cone.mode == ellipse_cone_mode::spherical) return 1.0 / cone.omega;
-  return t * t / (den * static_cast<double>(e.area));  // d^2 / (|cos| A) with |cos| = den
-}
+std::vector<ellipse_case> battery() { return test::ellipse_battery(); }
 
 // ------------------------------------------------------------------ Carlson
 
@@ -199,10 +140,23 @@ TEST(SphericalEllipse, SeedSimpsonAreaError) {
 
 // ------------------------------------------------------------------ pdf consistency
 
-template <class Solver>
+// The strategy tests run for both maps (typed tests) and, where the seed's
+// solver is meant, for it too.
+template <class Sampler>
+class EllipseSolidAngleSampler : public ::testing::Test {};
+struct ellipse_sampler_names {
+  template <class T>
+  static std::string GetName(int) {
+    return std::is_same_v<T, ellipse_polar_solid_angle_sampler> ? "Polar" : "Parallel";
+  }
+};
+using ellipse_samplers = ::testing::Types<ellipse_solid_angle_sampler, ellipse_polar_solid_angle_sampler>;
+TYPED_TEST_SUITE(EllipseSolidAngleSampler, ellipse_samplers, ellipse_sampler_names);
+
+template <class Sampler>
 void check_pdf_consistency(const char* solver_name, double tol) {
   for (const ellipse_case& c : battery()) {
-    const basic_ellipse_solid_angle_sampler<Solver> smp{c.shape};
+    const Sampler smp{c.shape};
     const ellipse_area_sampler area{c.shape};
     pcg32 rng(5, 9);
     int misses = 0, area_misses = 0;
@@ -226,18 +180,22 @@ void check_pdf_consistency(const char* solver_name, double tol) {
   }
 }
 
-TEST(SphericalEllipse, PdfConsistencyNewton) { check_pdf_consistency<newton_carlson_solver>("newton", 1e-5); }
-TEST(SphericalEllipse, PdfConsistencySeed) { check_pdf_consistency<bisection_simpson_solver>("seed", 1e-5); }
+TYPED_TEST(EllipseSolidAngleSampler, PdfConsistency) { check_pdf_consistency<TypeParam>("newton", 1e-5); }
+TEST(SphericalEllipse, PdfConsistencySeed) {
+  check_pdf_consistency<ellipse_solid_angle_sampler_bisection_simpson>("seed", 1e-5);
+}
 
-// Behind the light, in its plane: no sample and pdf 0, whatever the solver.
-TEST(SphericalEllipse, OneSided) {
+// Behind the light, in its plane: no sample, pdf 0, no inverse.
+TYPED_TEST(EllipseSolidAngleSampler, OneSided) {
   const ellipse e = ellipse::make({0, 0, 0}, {1, 0, 0}, {0, 0.5f, 0});
-  const ellipse_solid_angle_sampler smp{e};
+  const TypeParam smp{e};
   light_sample s;
+  vec2 u;
   for (const vec3 o : {vec3(0.2f, 0.1f, -1.0f), vec3(3.0f, 0.0f, 0.0f), vec3(0.1f, 0.1f, 0.0f)}) {
     EXPECT_FALSE(smp.faces(o));
     EXPECT_FALSE(smp.sample(o, {0.3f, 0.6f}, s));
     EXPECT_EQ(smp.pdf(o, glm::normalize(-o + vec3(0.01f, 0.0f, 0.0f))), 0.0f);
+    EXPECT_FALSE(smp.invert(o, glm::normalize(-o + vec3(0.01f, 0.0f, 0.0f)), u));
   }
   // Misses have pdf 0.
   EXPECT_EQ(smp.pdf({0, 0, 1}, {0, 0, 1}), 0.0f);
@@ -249,9 +207,9 @@ TEST(SphericalEllipse, OneSided) {
 // E[1/pdf] = Omega against the independent quadrature, within 0.5 % (in the
 // spherical mode 1/pdf is Omega itself; in the area fallback a Monte Carlo
 // estimate).
-TEST(SphericalEllipse, ExpectedInversePdf) {
+TYPED_TEST(EllipseSolidAngleSampler, ExpectedInversePdf) {
   for (const ellipse_case& c : battery()) {
-    const ellipse_solid_angle_sampler smp{c.shape};
+    const TypeParam smp{c.shape};
     const double ref = test::solid_angle_ellipse(dvec3(c.o), dvec3(c.shape.center), dvec3(c.shape.a1),
                                                  dvec3(c.shape.a2));
     pcg32 rng(11, 3);
@@ -269,37 +227,42 @@ TEST(SphericalEllipse, ExpectedInversePdf) {
 // ------------------------------------------------------------------ chi-square
 
 std::vector<ellipse_case> chi2_battery() {
-  std::vector<ellipse_case> all = battery(), out;
-  for (ellipse_case& c : all)
-    // Slivers thinner than float direction precision (b < ~1e-5 rad) cannot
-    // be binned from float directions; they are covered by the other tests.
-    // The harness's adaptive cell integration also misjudges the mass of
-    // slivers with a/b >= 1e3 (it reports 1.09 at a/b = 1e4).
-    if (c.name == "disk_overhead" || c.name == "disk_offaxis" || c.name == "ellipse_3to1_tilted" ||
-        c.name == "ellipse_flipped" || c.name == "disk_close_near_2pi" || c.name == "disk_far_offaxis" ||
-        c.name == "disk_tiny_1em8sr" || c.name == "ratio_1e2" || c.name == "ratio_1e4_grazing_fallback")
-      out.push_back(c);
-  return out;
+  // Slivers thinner than float direction precision (b < ~1e-5 rad) cannot
+  // be binned from float directions, and the harness's adaptive cell
+  // integration misjudges the mass of slivers with a/b >= 1e3 (it reports
+  // 1.09 at a/b = 1e4): those are tested on the light's own square below.
+  return test::ellipse_cases_named({"disk_overhead", "disk_offaxis", "ellipse_3to1_tilted", "ellipse_flipped",
+                                    "ellipse_10to1_close", "disk_close_near_2pi", "disk_far_offaxis",
+                                    "disk_tiny_1em8sr", "ratio_1e2", "ratio_1e4_grazing_fallback"});
 }
 
 class SphericalEllipseChi2 : public ::testing::TestWithParam<ellipse_case> {};
 
-TEST_P(SphericalEllipseChi2, Newton) {
-  const ellipse_case& c = GetParam();
-  const ellipse_solid_angle_sampler smp{c.shape};
+template <class Sampler>
+test::chi2_result direction_chi2(const ellipse_case& c, std::uint64_t seed) {
+  const Sampler smp{c.shape};
   const auto sample = [&](pcg32& rng, vec3& d) {
     light_sample s;
     if (!smp.sample(c.o, rng.uniform2(), s)) return false;
     d = s.dir;
     return true;
   };
-  const auto pdf = [&](const dvec3& d) { return pdf_double<newton_carlson_solver>(c.shape, c.o, d); };
+  const auto pdf = [&](const dvec3& d) { return test::ellipse_pdf_double<newton_carlson_solver>(c.shape, c.o, d); };
   const test::spherical_cap cap = test::bounding_cap(dvec3(c.o), c.shape);
   test::chi2_options opt;
   opt.sample_count = 100'000;
-  opt.seed = 23;
-  const test::chi2_result r = test::chi2_test_directions(sample, pdf, cap.axis, cap.one_minus_cos, opt);
-  EXPECT_TRUE(r.passed) << c.name << "\n" << r.report;
+  opt.seed = seed;
+  return test::chi2_test_directions(sample, pdf, cap.axis, cap.one_minus_cos, opt);
+}
+
+TEST_P(SphericalEllipseChi2, Newton) {
+  const test::chi2_result r = direction_chi2<ellipse_solid_angle_sampler>(GetParam(), 23);
+  EXPECT_TRUE(r.passed) << GetParam().name << "\n" << r.report;
+}
+
+TEST_P(SphericalEllipseChi2, Polar) {
+  const test::chi2_result r = direction_chi2<ellipse_polar_solid_angle_sampler>(GetParam(), 29);
+  EXPECT_TRUE(r.passed) << GetParam().name << "\n" << r.report;
 }
 
 INSTANTIATE_TEST_SUITE_P(Battery, SphericalEllipseChi2, ::testing::ValuesIn(chi2_battery()),
@@ -373,10 +336,10 @@ test::chi2_result surface_chi2(const ellipse_case& c, std::uint64_t seed, std::s
   return r;
 }
 
-// The parallel map with solver Solver, as the sampler basic_ellipse_solid_angle_sampler<Solver>.
+// The parallel map with solver Solver, as the sampler basic_ellipse_solid_angle_sampler<parallel_map<Solver>>.
 template <class Solver>
 test::chi2_result parallel_surface_chi2(const ellipse_case& c, std::uint64_t seed, std::size_t count) {
-  return surface_chi2<Solver, basic_ellipse_solid_angle_sampler<Solver>>(
+  return surface_chi2<Solver, basic_ellipse_solid_angle_sampler<parallel_map<Solver>>>(
       c, seed, count, [](dvec2 u, const spherical_ellipse& se, double omega) {
         return square_to_spherical_ellipse<Solver>(u, se, omega);
       });
@@ -445,11 +408,11 @@ TEST(SphericalEllipse, RoundTripCanonical) {
 
 // Through the sampler's float API on configurations whose spherical ellipse
 // is wide compared with float direction precision.
-TEST(SphericalEllipse, RoundTripSampler) {
+TYPED_TEST(EllipseSolidAngleSampler, RoundTripSampler) {
   for (const ellipse_case& c : battery()) {
     const ellipse_cone cone = make_ellipse_cone(c.shape, c.o);
     if (cone.mode != ellipse_cone_mode::spherical || cone.se.b < 1e-2) continue;
-    const ellipse_solid_angle_sampler smp{c.shape};
+    const TypeParam smp{c.shape};
     pcg32 rng(4, 4);
     for (int i = 0; i < 2000; ++i) {
       const vec2 u = rng.uniform2();
@@ -529,10 +492,10 @@ TEST(SphericalEllipse, SolverResidualRandomCones) {
 
 // Fallback: the decision depends on (ellipse, observer) only and the area
 // pdf is the exact d^2 / (|cos| A).
-TEST(SphericalEllipse, FallbackUsesExactAreaPdf) {
-  const ellipse_case c = make_case("fallback", 1, 1, {0, 2, 1e-9f});  // h / dist < 1e-9
+TYPED_TEST(EllipseSolidAngleSampler, FallbackUsesExactAreaPdf) {
+  const ellipse_case c = test::make_ellipse_case("fallback", 1, 1, {0, 2, 1e-9f});  // h / dist < 1e-9
   ASSERT_EQ(make_ellipse_cone(c.shape, c.o).mode, ellipse_cone_mode::area);
-  const ellipse_solid_angle_sampler smp{c.shape};
+  const TypeParam smp{c.shape};
   const ellipse_area_sampler area{c.shape};
   pcg32 rng(1, 1);
   for (int i = 0; i < 100; ++i) {

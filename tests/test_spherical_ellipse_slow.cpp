@@ -1,5 +1,6 @@
-// Fuzz test of solid-angle sampling of ellipses (sampling/spherical_ellipse.hpp)
-// over 10^6 random configurations: axis ratios up to 1e4, observers from
+// Fuzz test of solid-angle sampling of ellipses, by the parallel map
+// (sampling/spherical_ellipse.hpp) and by the polar map
+// (sampling/spherical_ellipse_polar.hpp), each over 10^6 random configurations: axis ratios up to 1e4, observers from
 // grazing (1e-7 of the distance) to far off-axis, either side, near and far.
 // Every sample must be a finite unit direction that hits the ellipse (up to
 // the float rounding of the direction), with a finite positive pdf equal to
@@ -11,6 +12,8 @@
 
 #include "mcrt/core/rng.hpp"
 #include "mcrt/sampling/spherical_ellipse.hpp"
+#include "mcrt/sampling/spherical_ellipse_polar.hpp"
+#include "support/ellipse_cases.hpp"
 
 namespace {
 
@@ -18,29 +21,24 @@ using namespace mcrt;
 
 ellipse_cone_mode mode_of(const ellipse& e, const vec3& o) { return make_ellipse_cone(e, o).mode; }
 
-vec3 random_unit(pcg32& rng) {
-  for (;;) {
-    const vec3 d{2.0f * rng.uniform() - 1.0f, 2.0f * rng.uniform() - 1.0f, 2.0f * rng.uniform() - 1.0f};
-    const float l2 = glm::dot(d, d);
-    if (l2 > 1e-4f && l2 <= 1.0f) return d / std::sqrt(l2);
-  }
-}
+using test::random_unit_vector;
 
-TEST(SphericalEllipseSlow, Fuzz) {
+template <class Sampler>
+void fuzz(const char* map_name) {
   pcg32 rng(2024, 5);
   constexpr int configurations = 1'000'000;
   long no_sample = 0, ill_conditioned = 0, spherical = 0, far_misses = 0, rim_misses = 0;
   for (int i = 0; i < configurations; ++i) {
     // Ellipse: random orientation, size 10^[-3, 2], axis ratio 10^[0, 4].
-    const vec3 u = random_unit(rng);
-    vec3 v = glm::normalize(glm::cross(u, random_unit(rng)));
+    const vec3 u = random_unit_vector(rng);
+    vec3 v = glm::normalize(glm::cross(u, random_unit_vector(rng)));
     if (!all_finite(v)) v = glm::normalize(glm::cross(u, vec3(0.3f, 0.5f, 0.8f)));
     const float r1 = std::pow(10.0f, -3.0f + 5.0f * rng.uniform());
     const float r2 = r1 * std::pow(10.0f, -4.0f * rng.uniform());
-    const vec3 center = 10.0f * (2.0f * rng.uniform2().x - 1.0f) * random_unit(rng);
+    const vec3 center = 10.0f * (2.0f * rng.uniform2().x - 1.0f) * random_unit_vector(rng);
     const ellipse e = ellipse::make(center, r1 * u, r2 * v, rng.uniform() < 0.5f);
     // Observer: distance 10^[-2, 3] times r1, direction mixing grazing ones in.
-    vec3 dir = random_unit(rng);
+    vec3 dir = random_unit_vector(rng);
     const float kind = rng.uniform();
     if (kind < 0.25f) {  // grazing: height 10^[-7, -1] of the distance
       dir -= glm::dot(dir, e.n) * e.n;
@@ -48,7 +46,7 @@ TEST(SphericalEllipseSlow, Fuzz) {
       dir = glm::normalize(dir);
     }
     const vec3 o = center + r1 * std::pow(10.0f, -2.0f + 5.0f * rng.uniform()) * dir;
-    const ellipse_solid_angle_sampler smp{e};
+    const Sampler smp{e};
     light_sample s;
     const vec2 uu = rng.uniform2();
     if (!smp.sample(o, uu, s)) {
@@ -102,8 +100,11 @@ TEST(SphericalEllipseSlow, Fuzz) {
   // the direction) and ill-conditioned grazing cases are only counted: the
   // fuzz draws slivers down to 1e-10 rad wide, far below float resolution.
   EXPECT_GT(spherical, configurations / 2);
-  std::printf("no sample %ld, spherical map %ld, rim misses %ld, ill-conditioned area pdf %ld, of %d\n", no_sample,
-              spherical, rim_misses, ill_conditioned, configurations);
+  std::printf("%s map: no sample %ld, spherical map %ld, rim misses %ld, ill-conditioned area pdf %ld, of %d\n",
+              map_name, no_sample, spherical, rim_misses, ill_conditioned, configurations);
 }
+
+TEST(SphericalEllipseSlow, FuzzParallel) { fuzz<ellipse_solid_angle_sampler>("parallel"); }
+TEST(SphericalEllipseSlow, FuzzPolar) { fuzz<ellipse_polar_solid_angle_sampler>("polar"); }
 
 }  // namespace

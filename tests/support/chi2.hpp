@@ -94,6 +94,10 @@ struct chi2_result {
   std::string report;       // human readable: why it failed, worst cells (observed vs expected)
 };
 
+// P(X >= statistic) for X chi-square distributed with dof degrees of
+// freedom; defined below.
+inline double chi2_survival(double statistic, int dof);
+
 namespace detail {
 
 // Regularized upper incomplete gamma Q(a, x) by Numerical Recipes (3rd ed.,
@@ -344,18 +348,23 @@ class cell_integrator {
 // increasing order of expected count; cells below chi2_pool_threshold are
 // accumulated until the pool reaches it. Empty cells that expect nothing are
 // skipped. bins is the number of terms of the statistic.
-inline void pooled_statistic(const std::vector<double>& observed, const std::vector<double>& expected, double& stat,
-                             int& bins, std::size_t& pooled_in, std::size_t& pooled_out,
-                             std::size_t& zero_expected_hit) {
+struct pool_info {
+  std::size_t pooled_in = 0, pooled_out = 0, zero_expected_hit = 0;
+};
+// Sets res.statistic, res.dof (bins - 1) and res.p_value.
+inline pool_info pooled_statistic(const std::vector<double>& observed, const std::vector<double>& expected,
+                                  chi2_result& res) {
   const std::size_t cells = observed.size();
   std::vector<std::size_t> order(cells);
   std::iota(order.begin(), order.end(), std::size_t{0});
   std::stable_sort(order.begin(), order.end(),
                    [&](std::size_t i, std::size_t j) { return expected[i] < expected[j]; });
-  stat = 0.0;
-  bins = 0;
-  pooled_in = pooled_out = zero_expected_hit = 0;
-  double pool_obs = 0.0, pool_exp = 0.0;
+  double stat = 0.0, pool_obs = 0.0, pool_exp = 0.0;
+  int bins = 0;
+  pool_info pi;
+  std::size_t& pooled_in = pi.pooled_in;
+  std::size_t& pooled_out = pi.pooled_out;
+  std::size_t& zero_expected_hit = pi.zero_expected_hit;
   for (const std::size_t c : order) {
     const double o = observed[c], e = expected[c];
     if (e == 0.0 && o == 0.0) continue;
@@ -379,6 +388,43 @@ inline void pooled_statistic(const std::vector<double>& observed, const std::vec
     stat += sqr(pool_obs - pool_exp) / pool_exp;
     ++bins;
   }
+  res.statistic = stat;
+  res.dof = bins - 1;
+  res.p_value = res.dof >= 1 ? chi2_survival(stat, res.dof) : 0.0;
+  return pi;
+}
+
+// The failures every test shares: sample() returning false, a density whose
+// integral over the domain is not 1, too few degrees of freedom, a p-value
+// below alpha. Appends one line per failure; false if any.
+inline bool shared_verdict(std::ostringstream& rep, const chi2_result& res, std::size_t n_false,
+                           std::size_t sample_count, const char* domain, double alpha) {
+  bool ok = true;
+  if (n_false > 0) {
+    ok = false;
+    rep << "FAIL: sample() returned false for " << n_false << " of " << sample_count << " samples\n";
+  }
+  if (!(std::abs(res.pdf_integral - 1.0) <= chi2_mass_tolerance)) {
+    ok = false;
+    rep << "FAIL: the density integrates to " << res.pdf_integral << " over " << domain << ", not 1\n";
+  }
+  if (res.dof < 1) {
+    ok = false;
+    rep << "FAIL: too few degrees of freedom (" << res.dof << ")\n";
+  }
+  if (!(res.p_value >= alpha)) {
+    ok = false;
+    rep << "FAIL: null hypothesis rejected, p-value " << res.p_value << " < " << alpha << "\n";
+  }
+  return ok;
+}
+
+inline void report_pooling(std::ostringstream& rep, const pool_info& pi) {
+  if (pi.pooled_in > 0)
+    rep << "pooled " << pi.pooled_in << " cells expecting < " << chi2_pool_threshold << " samples into "
+        << pi.pooled_out << " bins\n";
+  if (pi.zero_expected_hit > 0)
+    rep << pi.zero_expected_hit << " cells with integrated density 0 received samples (pooled)\n";
 }
 
 inline std::string format_direction(const dvec3& d) {
@@ -541,21 +587,11 @@ chi2_result chi2_test_directions(Sample&& sample, Pdf&& pdf, const dvec3& axis, 
   res.pdf_integral = mass;
 
   // ---- pooling and the statistic
-  double stat = 0.0;
-  int bins = 0;
-  std::size_t pooled_in = 0, pooled_out = 0, zero_expected_hit = 0;
-  detail::pooled_statistic(observed, expected, stat, bins, pooled_in, pooled_out, zero_expected_hit);
-  res.statistic = stat;
-  res.dof = bins - 1;
-  res.p_value = res.dof >= 1 ? chi2_survival(stat, res.dof) : 0.0;
+  const detail::pool_info pool = detail::pooled_statistic(observed, expected, res);
   const double alpha = chi2_per_test_significance();
 
   // ---- verdict
-  bool ok = true;
-  if (n_false > 0) {
-    ok = false;
-    rep << "FAIL: sample() returned false for " << n_false << " of " << opt.sample_count << " samples\n";
-  }
+  bool ok = detail::shared_verdict(rep, res, n_false, opt.sample_count, "the cap", alpha);
   if (n_nonfinite > 0) {
     ok = false;
     rep << "FAIL: " << n_nonfinite << " samples are not finite nonzero directions, first "
@@ -576,21 +612,9 @@ chi2_result chi2_test_directions(Sample&& sample, Pdf&& pdf, const dvec3& axis, 
     rep << "FAIL: pdf is negative or not finite at " << detail::format_direction(integ.bad_direction()) << ": "
         << integ.bad_pdf() << "\n";
   }
-  if (!(std::abs(mass - 1.0) <= chi2_mass_tolerance)) {
-    ok = false;
-    rep << "FAIL: the pdf integrates to " << mass << " over the cap, not 1\n";
-  }
-  if (res.dof < 1) {
-    ok = false;
-    rep << "FAIL: too few degrees of freedom (" << res.dof << ")\n";
-  }
-  if (!(res.p_value >= alpha)) {
-    ok = false;
-    rep << "FAIL: null hypothesis rejected, p-value " << res.p_value << " < " << alpha << "\n";
-  }
   res.passed = ok;
 
-  rep << (ok ? "passed" : "failed") << ": chi2 = " << stat << ", dof = " << res.dof << ", p-value = " << res.p_value
+  rep << (ok ? "passed" : "failed") << ": chi2 = " << res.statistic << ", dof = " << res.dof << ", p-value = " << res.p_value
       << " (level " << alpha << " = 1% family-wise over " << chi2_max_tests_in_suite << " tests, Sidak)\n";
   rep << "grid " << nt << " (1 - cos) x " << np << " (phi) over the cap 1 - cos <= " << cap << " about "
       << detail::format_direction(a) << ", " << opt.sample_count << " samples, pdf integral " << mass << " ("
@@ -598,11 +622,7 @@ chi2_result chi2_test_directions(Sample&& sample, Pdf&& pdf, const dvec3& axis, 
   if (n_zero_pdf > 0 && ok)
     rep << n_zero_pdf << " samples with pdf 0 in their own direction, within the allowed fraction "
         << opt.zero_pdf_fraction << ", first " << detail::format_direction(first_zero) << "\n";
-  if (pooled_in > 0)
-    rep << "pooled " << pooled_in << " cells expecting < " << chi2_pool_threshold << " samples into " << pooled_out
-        << " bins\n";
-  if (zero_expected_hit > 0)
-    rep << zero_expected_hit << " cells with integrated pdf 0 received samples (pooled)\n";
+  detail::report_pooling(rep, pool);
 
   // Worst unpooled cells by their share of the statistic.
   std::vector<std::size_t> worst;
@@ -714,20 +734,10 @@ chi2_result chi2_test_unit_square(Sample&& sample, Density&& density, const chi2
     }
   res.pdf_integral = mass;
 
-  double stat = 0.0;
-  int bins = 0;
-  std::size_t pooled_in = 0, pooled_out = 0, zero_expected_hit = 0;
-  detail::pooled_statistic(observed, expected, stat, bins, pooled_in, pooled_out, zero_expected_hit);
-  res.statistic = stat;
-  res.dof = bins - 1;
-  res.p_value = res.dof >= 1 ? chi2_survival(stat, res.dof) : 0.0;
+  const detail::pool_info pool = detail::pooled_statistic(observed, expected, res);
   const double alpha = chi2_per_test_significance();
 
-  bool ok = true;
-  if (n_false > 0) {
-    ok = false;
-    rep << "FAIL: sample() returned false for " << n_false << " of " << opt.sample_count << " samples\n";
-  }
+  bool ok = detail::shared_verdict(rep, res, n_false, opt.sample_count, "the square", alpha);
   if (n_outside > 0) {
     ok = false;
     rep << "FAIL: " << n_outside << " samples fall outside the unit square, first (" << first_outside.x << ", "
@@ -737,26 +747,11 @@ chi2_result chi2_test_unit_square(Sample&& sample, Density&& density, const chi2
     ok = false;
     rep << "FAIL: density negative or not finite at (" << bad_at.x << ", " << bad_at.y << "): " << bad_value << "\n";
   }
-  if (!(std::abs(mass - 1.0) <= chi2_mass_tolerance)) {
-    ok = false;
-    rep << "FAIL: the density integrates to " << mass << " over the square, not 1\n";
-  }
-  if (res.dof < 1) {
-    ok = false;
-    rep << "FAIL: too few degrees of freedom (" << res.dof << ")\n";
-  }
-  if (!(res.p_value >= alpha)) {
-    ok = false;
-    rep << "FAIL: null hypothesis rejected, p-value " << res.p_value << " < " << alpha << "\n";
-  }
   res.passed = ok;
-  rep << (ok ? "passed" : "failed") << ": chi2 = " << stat << ", dof = " << res.dof << ", p-value = " << res.p_value
+  rep << (ok ? "passed" : "failed") << ": chi2 = " << res.statistic << ", dof = " << res.dof << ", p-value = " << res.p_value
       << " (level " << alpha << "), grid " << n << " x " << n << " on the light's square, " << opt.sample_count
       << " samples, density integral " << mass << "\n";
-  if (pooled_in > 0)
-    rep << "pooled " << pooled_in << " cells expecting < " << chi2_pool_threshold << " samples into " << pooled_out
-        << " bins\n";
-  if (zero_expected_hit > 0) rep << zero_expected_hit << " cells with integrated density 0 received samples (pooled)\n";
+  detail::report_pooling(rep, pool);
   res.report = rep.str();
   return res;
 }

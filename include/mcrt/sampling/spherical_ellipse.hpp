@@ -620,11 +620,29 @@ inline ellipse_cone make_ellipse_cone(const ellipse& e, const vec3& o) {
   return make_ellipse_cone<Solver, Frame>(e, ellipse_frame(e), o);
 }
 
-// Light-sampling strategy: uniform in the solid angle of the ellipse from o
-// (one-sided: nothing behind), through the parallel map of the spherical
-// ellipse; area sampling with its exact pdf where the map is unreliable.
+// The parallel map with solver Solver, as the Map policy of
+// basic_ellipse_solid_angle_sampler: sample (unit square -> tangent-plane
+// point of the canonical cone), invert, and the solver whose Omega the cone
+// carries (the pdf is 1 / that Omega). spherical_ellipse_polar.hpp has the
+// polar map.
 template <class Solver = newton_carlson_solver>
+struct parallel_map {
+  using solver = Solver;
+  static dvec2 sample(dvec2 u, const spherical_ellipse& se, double omega) {
+    return square_to_spherical_ellipse<Solver>(u, se, omega);
+  }
+  static dvec2 invert(dvec2 p, const spherical_ellipse& se, double omega) {
+    return spherical_ellipse_to_square<Solver>(p, se, omega);
+  }
+};
+
+// Light-sampling strategy: uniform in the solid angle of the ellipse from o
+// (one-sided: nothing behind), through an area-preserving map of the
+// spherical ellipse (Map: parallel_map or polar_map); area sampling with its
+// exact pdf where make_ellipse_cone() says the map is unreliable.
+template <class Map = parallel_map<>>
 struct basic_ellipse_solid_angle_sampler {
+  using solver = typename Map::solver;
   ellipse shape;  // fixed after construction (frame_ is derived from it)
 
   explicit basic_ellipse_solid_angle_sampler(const ellipse& e) : shape(e), frame_(e) {}
@@ -632,11 +650,10 @@ struct basic_ellipse_solid_angle_sampler {
   bool faces(const vec3& o) const { return shape.faces(o); }
 
   bool sample(const vec3& o, vec2 u, light_sample& s) const {
-    const ellipse_cone cone = make_ellipse_cone<Solver>(shape, frame_, o);
+    const ellipse_cone cone = make_ellipse_cone<solver>(shape, frame_, o);
     if (cone.mode == ellipse_cone_mode::none) return false;
     if (cone.mode == ellipse_cone_mode::area) return ellipse_area_sampler{shape}.sample(o, u, s);
-    const dvec2 p = square_to_spherical_ellipse<Solver>(dvec2(u), cone.se, cone.omega);
-    dvec2 xe = cone.ellipse_coords(p);
+    dvec2 xe = cone.ellipse_coords(Map::sample(dvec2(u), cone.se, cone.omega));
     // The map lands inside the ellipse; rounding may leave it ~1e-12 out.
     const double r2 = glm::dot(xe, xe);
     if (r2 > 1.0) xe /= std::sqrt(r2);
@@ -645,6 +662,8 @@ struct basic_ellipse_solid_angle_sampler {
     s.dir = vec3(v / len);
     s.dist = static_cast<float>(len);
     s.pdf = static_cast<float>(square_to_spherical_ellipse_pdf(cone.omega));
+    // omega >= min_omega keeps 1/omega finite in float; the checks keep any
+    // non-finite sample from reaching the integrator.
     return std::isfinite(s.pdf) && s.pdf > 0.0f && all_finite(s.dir);
   }
 
@@ -655,7 +674,7 @@ struct basic_ellipse_solid_angle_sampler {
   float pdf(const vec3& o, const vec3& dir) const {
     float t;
     if (!shape.faces(o) || !shape.intersect({o, dir}, 0.0f, infinity, t)) return 0.0f;
-    const ellipse_cone cone = make_ellipse_cone<Solver, false>(shape, frame_, o);
+    const ellipse_cone cone = make_ellipse_cone<solver, false>(shape, frame_, o);
     if (cone.mode == ellipse_cone_mode::none) return 0.0f;
     if (cone.mode == ellipse_cone_mode::area) return ellipse_area_sampler{shape}.pdf(o, dir);
     return static_cast<float>(square_to_spherical_ellipse_pdf(cone.omega));
@@ -664,7 +683,7 @@ struct basic_ellipse_solid_angle_sampler {
   // The u that sample() maps to dir (dir must hit the ellipse); false where
   // sample() has no sample for o.
   bool invert(const vec3& o, const vec3& dir, vec2& u) const {
-    const ellipse_cone cone = make_ellipse_cone<Solver>(shape, frame_, o);
+    const ellipse_cone cone = make_ellipse_cone<solver>(shape, frame_, o);
     if (cone.mode == ellipse_cone_mode::none) return false;
     if (cone.mode == ellipse_cone_mode::area) {
       float t;
@@ -673,8 +692,8 @@ struct basic_ellipse_solid_angle_sampler {
       return true;
     }
     const dvec3 p = cone.to_cone(dvec3(dir));
-    if (!(p.z > 0.0)) return false;
-    u = vec2(spherical_ellipse_to_square<Solver>({p.x / p.z, p.y / p.z}, cone.se, cone.omega));
+    if (!(p.z > 0.0)) return false;  // not in the cone's nappe: no tangent-plane point
+    u = vec2(Map::invert({p.x / p.z, p.y / p.z}, cone.se, cone.omega));
     return true;
   }
 
@@ -683,6 +702,6 @@ struct basic_ellipse_solid_angle_sampler {
 };
 
 using ellipse_solid_angle_sampler = basic_ellipse_solid_angle_sampler<>;
-using ellipse_solid_angle_sampler_bisection_simpson = basic_ellipse_solid_angle_sampler<bisection_simpson_solver>;
+using ellipse_solid_angle_sampler_bisection_simpson = basic_ellipse_solid_angle_sampler<parallel_map<bisection_simpson_solver>>;
 
 }  // namespace mcrt

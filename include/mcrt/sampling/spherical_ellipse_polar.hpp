@@ -286,68 +286,21 @@ inline dvec2 spherical_ellipse_polar_to_square(dvec2 p, const spherical_ellipse&
   return {std::clamp(0.25 * u1, 0.0, 1.0), std::clamp(u2, 0.0, 1.0)};
 }
 
-// Light-sampling strategy: uniform in the solid angle of the ellipse from o
-// (one-sided: nothing behind), through the polar map of the spherical
-// ellipse; area sampling with its exact pdf where make_ellipse_cone() says
-// the spherical set-up is unreliable (the same fallbacks, thresholds and
-// solid angle as basic_ellipse_solid_angle_sampler).
-struct ellipse_polar_solid_angle_sampler {
-  ellipse shape;  // fixed after construction (frame_ is derived from it)
-
-  explicit ellipse_polar_solid_angle_sampler(const ellipse& e) : shape(e), frame_(e) {}
-
-  bool faces(const vec3& o) const { return shape.faces(o); }
-
-  bool sample(const vec3& o, vec2 u, light_sample& s) const {
-    const ellipse_cone cone = make_ellipse_cone(shape, frame_, o);
-    if (cone.mode == ellipse_cone_mode::none) return false;
-    if (cone.mode == ellipse_cone_mode::area) return ellipse_area_sampler{shape}.sample(o, u, s);
-    const dvec2 p = square_to_spherical_ellipse_polar(dvec2(u), cone.se, cone.omega);
-    dvec2 xe = cone.ellipse_coords(p);
-    // The map lands inside the ellipse; rounding may leave it ~1e-12 out.
-    const double r2 = glm::dot(xe, xe);
-    if (r2 > 1.0) xe /= std::sqrt(r2);
-    const dvec3 v = cone.d + xe.x * dvec3(shape.a1) + xe.y * dvec3(shape.a2);
-    const double len = glm::length(v);
-    s.dir = vec3(v / len);
-    s.dist = static_cast<float>(len);
-    s.pdf = static_cast<float>(square_to_spherical_ellipse_polar_pdf(cone.omega));
-    // omega >= 1e-30 (min_omega) keeps 1/omega finite in float; the checks
-    // keep any non-finite sample from reaching the integrator.
-    return std::isfinite(s.pdf) && s.pdf > 0.0f && all_finite(s.dir);
+// The polar map as the Map policy of basic_ellipse_solid_angle_sampler
+// (spherical_ellipse.hpp): the same cone set-up, fallbacks, thresholds and
+// solid angle (the AGM of spherical_ellipse_area) as the parallel map.
+struct polar_map {
+  using solver = newton_carlson_solver;  // whose Omega the cone carries
+  static dvec2 sample(dvec2 u, const spherical_ellipse& se, double omega) {
+    return square_to_spherical_ellipse_polar(u, se, omega);
   }
-
-  // Density per unit SOLID ANGLE at o of the unit direction dir. The ray
-  // test comes first, as in basic_ellipse_solid_angle_sampler: a direction
-  // that misses costs no cone set-up.
-  float pdf(const vec3& o, const vec3& dir) const {
-    float t;
-    if (!shape.faces(o) || !shape.intersect({o, dir}, 0.0f, infinity, t)) return 0.0f;
-    const ellipse_cone cone = make_ellipse_cone<newton_carlson_solver, false>(shape, frame_, o);
-    if (cone.mode == ellipse_cone_mode::none) return 0.0f;
-    if (cone.mode == ellipse_cone_mode::area) return ellipse_area_sampler{shape}.pdf(o, dir);
-    return static_cast<float>(square_to_spherical_ellipse_polar_pdf(cone.omega));
+  static dvec2 invert(dvec2 p, const spherical_ellipse& se, double omega) {
+    return spherical_ellipse_polar_to_square(p, se, omega);
   }
-
-  // The u that sample() maps to dir (dir must hit the ellipse); false where
-  // sample() has no sample for o.
-  bool invert(const vec3& o, const vec3& dir, vec2& u) const {
-    const ellipse_cone cone = make_ellipse_cone(shape, frame_, o);
-    if (cone.mode == ellipse_cone_mode::none) return false;
-    if (cone.mode == ellipse_cone_mode::area) {
-      float t;
-      if (!shape.intersect({o, dir}, 0.0f, infinity, t)) return false;
-      u = ellipse_to_square(o + t * dir, shape);
-      return true;
-    }
-    const dvec3 p = cone.to_cone(dvec3(dir));
-    if (!(p.z > 0.0)) return false;  // not in the cone's nappe: no tangent-plane point
-    u = vec2(spherical_ellipse_polar_to_square({p.x / p.z, p.y / p.z}, cone.se, cone.omega));
-    return true;
-  }
-
- private:
-  ellipse_frame frame_;
 };
+
+// Light-sampling strategy: uniform in the solid angle of the ellipse from o
+// (one-sided) through the polar map.
+using ellipse_polar_solid_angle_sampler = basic_ellipse_solid_angle_sampler<polar_map>;
 
 }  // namespace mcrt
