@@ -1,12 +1,13 @@
 // Cost of solid-angle sampling of ellipses: sample plus pdf per call,
 // observers spread around the light (bench/observers.hpp), the same loop as
-// BM_SampleEllipseArea. The two solvers of the spherical ellipse's area
-// equation side by side: Newton on the Carlson closed form, and the seed's
-// 10-step bisection on a 10-interval Simpson rule.
+// BM_SampleEllipseArea. The two solvers of the parallel map's area equation
+// side by side (Newton on the Carlson closed form, and the seed's 10-step
+// bisection on a 10-interval Simpson rule), and the polar map.
 #include <benchmark/benchmark.h>
 
 #include "mcrt/core/rng.hpp"
 #include "mcrt/sampling/spherical_ellipse.hpp"
+#include "mcrt/sampling/spherical_ellipse_polar.hpp"
 #include "observers.hpp"
 
 namespace {
@@ -24,5 +25,11 @@ void BM_SampleEllipseSolidAngleBisectionSimpson(benchmark::State& state) {
   mcrt::bench::run_sample_and_pdf(state, s, mcrt::bench::observers_around(s.shape.center, s.shape.n, 130.0f));
 }
 BENCHMARK(BM_SampleEllipseSolidAngleBisectionSimpson);
+
+void BM_SampleEllipseSolidAnglePolar(benchmark::State& state) {
+  const mcrt::ellipse_polar_solid_angle_sampler s{bench_light};
+  mcrt::bench::run_sample_and_pdf(state, s, mcrt::bench::observers_around(s.shape.center, s.shape.n, 130.0f));
+}
+BENCHMARK(BM_SampleEllipseSolidAnglePolar);
 
 }  // namespace
