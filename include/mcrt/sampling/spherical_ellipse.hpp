@@ -237,7 +237,9 @@ struct newton_carlson_solver {
         // A local step: Halley's instead of Newton's (cubic convergence),
         // d = d_N / (1 + d_N L / 2) with L = f'' / f' the log-derivative of
         // the slice density (see below); its residual is integrated, not
-        // bounded, so any step inside the bracket is safe.
+        // bounded, so any step inside the bracket is safe. Not within 1e-3
+        // of psi = pi/2 (c <= 1e-3), where L has its -2 s / c pole and
+        // Newton's step is kept.
         const double a2 = se.a * se.a, b2 = se.b * se.b, s2 = sl.s * sl.s, c2 = sl.c * sl.c;
         const double lg = -2.0 * sl.s / sl.c - 2.0 * b2 * sl.s * sl.c / (1.0 + b2 * s2) +
                           (a2 - b2) * sl.s * sl.c / (1.0 + a2 * c2 + b2 * s2);
