@@ -63,6 +63,31 @@ inline double carlson_rc1(double e) {
   return carlson_rc(1.0, 1.0 + e);
 }
 
+namespace carlson_detail {
+
+// The truncated Taylor series that end the duplication loops (Carlson 1995,
+// eq. 2.2 and 2.4), from the scaled deviations X = (A0 - x0) / (4^n A_n),
+// formed from the original arguments, free of cancellation.
+// R_F: Z = -(X + Y); the series over sqrt(A_n).
+inline double rf_series(double xx, double yy, double a) {
+  const double zz = -(xx + yy);
+  const double e2 = xx * yy - zz * zz, e3 = xx * yy * zz;
+  return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / std::sqrt(a);
+}
+// R_J: P = -(X + Y + Z) / 2; 4^-m series / A_m^(3/2) plus 6 times the R_C sum.
+inline double rj_series(double xx, double yy, double zz, double a, double scale, double sum) {
+  const double pp = -0.5 * (xx + yy + zz);
+  const double e2 = xx * yy + xx * zz + yy * zz - 3.0 * pp * pp;
+  const double e3 = xx * yy * zz + 2.0 * e2 * pp + 4.0 * pp * pp * pp;
+  const double e4 = (2.0 * xx * yy * zz + e2 * pp + 3.0 * pp * pp * pp) * pp;
+  const double e5 = xx * yy * zz * pp * pp;
+  const double series = 1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0 -
+                        9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0;
+  return scale * series / (a * std::sqrt(a)) + 6.0 * sum;
+}
+
+}  // namespace carlson_detail
+
 // R_F(x, y, z) = 1/2 int_0^inf ((t + x)(t + y)(t + z))^(-1/2) dt; x, y, z >= 0,
 // at most one of them 0 (Carlson 1995, alg. 1).
 inline double carlson_rf(double x, double y, double z) {
@@ -80,10 +105,7 @@ inline double carlson_rf(double x, double y, double z) {
     a = 0.25 * (a + lambda);
     scale *= 0.25;
   }
-  // X = (A0 - x0) / (4^n A_n): from the original arguments, free of cancellation
-  const double xx = (a0 - x0) * scale / a, yy = (a0 - y0) * scale / a, zz = -(xx + yy);
-  const double e2 = xx * yy - zz * zz, e3 = xx * yy * zz;
-  return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / std::sqrt(a);
+  return carlson_detail::rf_series((a0 - x0) * scale / a, (a0 - y0) * scale / a, a);
 }
 
 // R_J(x, y, z, p) = 3/2 int_0^inf ((t + x)(t + y)(t + z))^(-1/2) (t + p)^(-1) dt;
@@ -110,15 +132,8 @@ inline double carlson_rj(double x, double y, double z, double p) {
     a = 0.25 * (a + lambda);
     scale *= 0.25;
   }
-  const double xx = (a0 - x0) * scale / a, yy = (a0 - y0) * scale / a, zz = (a0 - z0) * scale / a;
-  const double pp = -0.5 * (xx + yy + zz);
-  const double e2 = xx * yy + xx * zz + yy * zz - 3.0 * pp * pp;
-  const double e3 = xx * yy * zz + 2.0 * e2 * pp + 4.0 * pp * pp * pp;
-  const double e4 = (2.0 * xx * yy * zz + e2 * pp + 3.0 * pp * pp * pp) * pp;
-  const double e5 = xx * yy * zz * pp * pp;
-  const double series = 1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0 -
-                        9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0;
-  return scale * series / (a * std::sqrt(a)) + 6.0 * sum;
+  return carlson_detail::rj_series((a0 - x0) * scale / a, (a0 - y0) * scale / a, (a0 - z0) * scale / a, a, scale,
+                                   sum);
 }
 
 // R_F(x, y, z) and R_J(x, y, z, p) together: both duplicate x, y, z with the
@@ -148,20 +163,9 @@ inline void carlson_rf_rj(double x, double y, double z, double p, double& rf, do
     aj = 0.25 * (aj + lambda);
     scale *= 0.25;
   }
-  {
-    const double xx = (af0 - x0) * scale / af, yy = (af0 - y0) * scale / af, zz = -(xx + yy);
-    const double e2 = xx * yy - zz * zz, e3 = xx * yy * zz;
-    rf = (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / std::sqrt(af);
-  }
-  const double xx = (aj0 - x0) * scale / aj, yy = (aj0 - y0) * scale / aj, zz = (aj0 - z0) * scale / aj;
-  const double pp = -0.5 * (xx + yy + zz);
-  const double e2 = xx * yy + xx * zz + yy * zz - 3.0 * pp * pp;
-  const double e3 = xx * yy * zz + 2.0 * e2 * pp + 4.0 * pp * pp * pp;
-  const double e4 = (2.0 * xx * yy * zz + e2 * pp + 3.0 * pp * pp * pp) * pp;
-  const double e5 = xx * yy * zz * pp * pp;
-  const double series = 1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0 -
-                        9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0;
-  rj = scale * series / (aj * std::sqrt(aj)) + 6.0 * sum;
+  rf = carlson_detail::rf_series((af0 - x0) * scale / af, (af0 - y0) * scale / af, af);
+  rj = carlson_detail::rj_series((aj0 - x0) * scale / aj, (aj0 - y0) * scale / aj, (aj0 - z0) * scale / aj, aj,
+                                 scale, sum);
 }
 
 // Legendre's incomplete integral of the first kind F(phi | m), m = k^2 < 1,
