@@ -17,7 +17,10 @@
 // truncation error below `carlson_tolerance` (Carlson 1995, eq. 2.2-2.4:
 // Q = (3 r)^(-1/6) max |A0 - x_i| for R_F, (r/4)^(-1/6) for R_J).
 #include <algorithm>
+#include <array>
 #include <cmath>
+
+#include "mcrt/core/fast_math.hpp"
 
 namespace mcrt {
 
@@ -120,11 +123,15 @@ inline double carlson_rj(double x, double y, double z, double p) {
   double scale = 1.0;  // 4^-m
   double sum = 0.0;
   while (scale * q >= std::abs(a)) {
-    const double sx = std::sqrt(x), sy = std::sqrt(y), sz = std::sqrt(z), sp = std::sqrt(p);
+    // The four square roots of a step packed into one (each correctly
+    // rounded, as std::sqrt), and one division for both 1/d and
+    // e = delta 4^-3m / d^2: the step is a chain of them.
+    const std::array<double, 4> r = fast_math::sqrt4(x, y, z, p);
+    const double sx = r[0], sy = r[1], sz = r[2], sp = r[3];
     const double lambda = sx * (sy + sz) + sy * sz;
-    const double d = (sp + sx) * (sp + sy) * (sp + sz);
-    const double e = delta * (scale * scale * scale) / (d * d);
-    sum += scale * carlson_rc1(e) / d;
+    const double d = (sp + sx) * (sp + sy) * (sp + sz), inv_d = 1.0 / d;
+    const double e = delta * (scale * scale * scale) * (inv_d * inv_d);
+    sum += scale * carlson_rc1(e) * inv_d;
     x = 0.25 * (x + lambda);
     y = 0.25 * (y + lambda);
     z = 0.25 * (z + lambda);
@@ -150,11 +157,13 @@ inline void carlson_rf_rj(double x, double y, double z, double p, double& rf, do
                     std::max({std::abs(aj0 - x), std::abs(aj0 - y), std::abs(aj0 - z), std::abs(aj0 - p)});
   double scale = 1.0, sum = 0.0;
   while (scale * qf >= std::abs(af) || scale * qj >= std::abs(aj)) {
-    const double sx = std::sqrt(x), sy = std::sqrt(y), sz = std::sqrt(z), sp = std::sqrt(p);
+    // As in carlson_rj: packed square roots, one division.
+    const std::array<double, 4> r = fast_math::sqrt4(x, y, z, p);
+    const double sx = r[0], sy = r[1], sz = r[2], sp = r[3];
     const double lambda = sx * (sy + sz) + sy * sz;
-    const double d = (sp + sx) * (sp + sy) * (sp + sz);
-    const double e = delta * (scale * scale * scale) / (d * d);
-    sum += scale * carlson_rc1(e) / d;
+    const double d = (sp + sx) * (sp + sy) * (sp + sz), inv_d = 1.0 / d;
+    const double e = delta * (scale * scale * scale) * (inv_d * inv_d);
+    sum += scale * carlson_rc1(e) * inv_d;
     x = 0.25 * (x + lambda);
     y = 0.25 * (y + lambda);
     z = 0.25 * (z + lambda);
