@@ -89,6 +89,26 @@ inline double rj_series(double xx, double yy, double zz, double a, double scale,
   return scale * series / (a * std::sqrt(a)) + 6.0 * sum;
 }
 
+// One duplication step of R_J (Carlson 1995, alg. 4): adds the step's R_C
+// term 4^-m R_C(1, 1 + e_m) / d_m to sum, takes x, y, z, p 4 times closer to
+// their mean and returns lambda (by which the caller moves its A_m). The four
+// square roots are packed into one (each correctly rounded, as std::sqrt),
+// and one division gives both 1/d_m and e_m = delta 4^-3m / d_m^2: the step
+// is a chain of them.
+inline double rj_step(double& x, double& y, double& z, double& p, double scale, double delta, double& sum) {
+  const std::array<double, 4> r = fast_math::sqrt4(x, y, z, p);
+  const double sx = r[0], sy = r[1], sz = r[2], sp = r[3];
+  const double lambda = sx * (sy + sz) + sy * sz;
+  const double d = (sp + sx) * (sp + sy) * (sp + sz), inv_d = 1.0 / d;
+  const double e = delta * (scale * scale * scale) * (inv_d * inv_d);
+  sum += scale * carlson_rc1(e) * inv_d;
+  x = 0.25 * (x + lambda);
+  y = 0.25 * (y + lambda);
+  z = 0.25 * (z + lambda);
+  p = 0.25 * (p + lambda);
+  return lambda;
+}
+
 }  // namespace carlson_detail
 
 // R_F(x, y, z) = 1/2 int_0^inf ((t + x)(t + y)(t + z))^(-1/2) dt; x, y, z >= 0,
@@ -123,20 +143,7 @@ inline double carlson_rj(double x, double y, double z, double p) {
   double scale = 1.0;  // 4^-m
   double sum = 0.0;
   while (scale * q >= std::abs(a)) {
-    // The four square roots of a step packed into one (each correctly
-    // rounded, as std::sqrt), and one division for both 1/d and
-    // e = delta 4^-3m / d^2: the step is a chain of them.
-    const std::array<double, 4> r = fast_math::sqrt4(x, y, z, p);
-    const double sx = r[0], sy = r[1], sz = r[2], sp = r[3];
-    const double lambda = sx * (sy + sz) + sy * sz;
-    const double d = (sp + sx) * (sp + sy) * (sp + sz), inv_d = 1.0 / d;
-    const double e = delta * (scale * scale * scale) * (inv_d * inv_d);
-    sum += scale * carlson_rc1(e) * inv_d;
-    x = 0.25 * (x + lambda);
-    y = 0.25 * (y + lambda);
-    z = 0.25 * (z + lambda);
-    p = 0.25 * (p + lambda);
-    a = 0.25 * (a + lambda);
+    a = 0.25 * (a + carlson_detail::rj_step(x, y, z, p, scale, delta, sum));
     scale *= 0.25;
   }
   return carlson_detail::rj_series((a0 - x0) * scale / a, (a0 - y0) * scale / a, (a0 - z0) * scale / a, a, scale,
@@ -157,17 +164,7 @@ inline void carlson_rf_rj(double x, double y, double z, double p, double& rf, do
                     std::max({std::abs(aj0 - x), std::abs(aj0 - y), std::abs(aj0 - z), std::abs(aj0 - p)});
   double scale = 1.0, sum = 0.0;
   while (scale * qf >= std::abs(af) || scale * qj >= std::abs(aj)) {
-    // As in carlson_rj: packed square roots, one division.
-    const std::array<double, 4> r = fast_math::sqrt4(x, y, z, p);
-    const double sx = r[0], sy = r[1], sz = r[2], sp = r[3];
-    const double lambda = sx * (sy + sz) + sy * sz;
-    const double d = (sp + sx) * (sp + sy) * (sp + sz), inv_d = 1.0 / d;
-    const double e = delta * (scale * scale * scale) * (inv_d * inv_d);
-    sum += scale * carlson_rc1(e) * inv_d;
-    x = 0.25 * (x + lambda);
-    y = 0.25 * (y + lambda);
-    z = 0.25 * (z + lambda);
-    p = 0.25 * (p + lambda);
+    const double lambda = carlson_detail::rj_step(x, y, z, p, scale, delta, sum);
     af = 0.25 * (af + lambda);
     aj = 0.25 * (aj + lambda);
     scale *= 0.25;
