@@ -10,14 +10,14 @@
 namespace {
 
 void BM_SampleRectArea(benchmark::State& state) {
-  const mcrt::rect_area_sampler s{mcrt::xz_rect(213, 343, 227, 332, 554, true)};
-  mcrt::bench::run_sample_and_pdf(state, s, mcrt::bench::observers_around(s.shape.center(), s.shape.n, 130.0f));
+  const mcrt::rect_area_sampler s{mcrt::bench::cornell_rect_light()};
+  mcrt::bench::run_sample_and_pdf(state, s, mcrt::bench::observers_around(s.shape));
 }
 BENCHMARK(BM_SampleRectArea);
 
 void BM_SampleEllipseArea(benchmark::State& state) {
-  const mcrt::ellipse_area_sampler s{mcrt::ellipse::make({278, 554, 279.5}, {65, 0, 0}, {0, 0, 65})};
-  mcrt::bench::run_sample_and_pdf(state, s, mcrt::bench::observers_around(s.shape.center, s.shape.n, 130.0f));
+  const mcrt::ellipse_area_sampler s{mcrt::bench::cornell_disk_light()};
+  mcrt::bench::run_sample_and_pdf(state, s, mcrt::bench::observers_around(s.shape));
 }
 BENCHMARK(BM_SampleEllipseArea);
 

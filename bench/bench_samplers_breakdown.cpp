@@ -18,8 +18,8 @@ namespace {
 
 using namespace mcrt;
 
-const rect bench_rect = xz_rect(213, 343, 227, 332, 554, true);
-const ellipse bench_ellipse = ellipse::make({278, 554, 279.5}, {65, 0, 0}, {0, 0, 65});
+const rect bench_rect = bench::cornell_rect_light();
+const ellipse bench_ellipse = bench::cornell_disk_light();
 
 template <class Sampler>
 void sample_only(benchmark::State& state, const Sampler& s, const std::vector<vec3>& obs) {
@@ -49,10 +49,8 @@ void pdf_only(benchmark::State& state, const Sampler& s, const std::vector<vec3>
   state.SetItemsProcessed(state.iterations());
 }
 
-std::vector<vec3> rect_observers() { return bench::observers_around(bench_rect.center(), bench_rect.n, 130.0f); }
-std::vector<vec3> ellipse_observers() {
-  return bench::observers_around(bench_ellipse.center, bench_ellipse.n, 130.0f);
-}
+std::vector<vec3> rect_observers() { return bench::observers_around(bench_rect); }
+std::vector<vec3> ellipse_observers() { return bench::observers_around(bench_ellipse); }
 
 void BM_RectAreaSampleOnly(benchmark::State& st) { sample_only(st, rect_area_sampler{bench_rect}, rect_observers()); }
 void BM_RectAreaPdfOnly(benchmark::State& st) { pdf_only(st, rect_area_sampler{bench_rect}, rect_observers()); }
@@ -82,15 +80,9 @@ void BM_EllipseConeSetup(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 
-std::vector<spherical_ellipse> bench_cones() {
-  std::vector<spherical_ellipse> out;
-  for (const vec3& o : ellipse_observers()) out.push_back(make_ellipse_cone(bench_ellipse, o).se);
-  return out;
-}
-
 // Omega of the canonical cone alone (AGM).
 void BM_EllipseSolidAngleOmega(benchmark::State& state) {
-  const std::vector<spherical_ellipse> cones = bench_cones();
+  const std::vector<spherical_ellipse> cones = bench::canonical_cones(bench_ellipse);
   std::size_t i = 0;
   for (auto _ : state) benchmark::DoNotOptimize(spherical_ellipse_area(cones[i++ & (cones.size() - 1)]));
   state.SetItemsProcessed(state.iterations());
@@ -98,7 +90,7 @@ void BM_EllipseSolidAngleOmega(benchmark::State& state) {
 
 // The parallel map's area-equation solver alone (Omega precomputed).
 void BM_EllipseSolidAngleSolver(benchmark::State& state) {
-  const std::vector<spherical_ellipse> cones = bench_cones();
+  const std::vector<spherical_ellipse> cones = bench::canonical_cones(bench_ellipse);
   std::vector<double> omegas;
   for (const spherical_ellipse& se : cones) omegas.push_back(spherical_ellipse_area(se));
   pcg32 rng(1, 2);

@@ -12,23 +12,23 @@
 
 namespace {
 
-const mcrt::ellipse bench_light = mcrt::ellipse::make({278, 554, 279.5}, {65, 0, 0}, {0, 0, 65});
+const mcrt::ellipse bench_light = mcrt::bench::cornell_disk_light();
 
 void BM_SampleEllipseSolidAngle(benchmark::State& state) {
   const mcrt::ellipse_solid_angle_sampler s{bench_light};
-  mcrt::bench::run_sample_and_pdf(state, s, mcrt::bench::observers_around(s.shape.center, s.shape.n, 130.0f));
+  mcrt::bench::run_sample_and_pdf(state, s, mcrt::bench::observers_around(s.shape));
 }
 BENCHMARK(BM_SampleEllipseSolidAngle);
 
 void BM_SampleEllipseSolidAngleBisectionSimpson(benchmark::State& state) {
   const mcrt::ellipse_solid_angle_sampler_bisection_simpson s{bench_light};
-  mcrt::bench::run_sample_and_pdf(state, s, mcrt::bench::observers_around(s.shape.center, s.shape.n, 130.0f));
+  mcrt::bench::run_sample_and_pdf(state, s, mcrt::bench::observers_around(s.shape));
 }
 BENCHMARK(BM_SampleEllipseSolidAngleBisectionSimpson);
 
 void BM_SampleEllipseSolidAnglePolar(benchmark::State& state) {
   const mcrt::ellipse_polar_solid_angle_sampler s{bench_light};
-  mcrt::bench::run_sample_and_pdf(state, s, mcrt::bench::observers_around(s.shape.center, s.shape.n, 130.0f));
+  mcrt::bench::run_sample_and_pdf(state, s, mcrt::bench::observers_around(s.shape));
 }
 BENCHMARK(BM_SampleEllipseSolidAnglePolar);
 

@@ -28,7 +28,6 @@
 
 #include "mcrt/core/fast_math.hpp"
 #include "mcrt/core/rng.hpp"
-#include "mcrt/geometry/rect.hpp"
 #include "mcrt/sampling/spherical_ellipse.hpp"
 #include "observers.hpp"
 
@@ -36,9 +35,7 @@ namespace {
 
 using namespace mcrt;
 
-// Set-up of UFK13's Algorithm 1 for a rectangle with unit edge directions
-// ex, ey, lengths exl, eyl, corner s, from observer o, and its sample; the
-// elementary functions are the policy F (libm or stand-ins).
+// The elementary functions of the rectangle's floors: libm's, or stand-ins.
 struct libm_functions {
   static float acos(float x) { return std::acos(x); }
   static float sin(float x) { return std::sin(x); }
@@ -58,6 +55,9 @@ struct ufk13_rect {
         exl(glm::length(r.e1)), eyl(glm::length(r.e2)) {}
 };
 
+// Set-up of UFK13's Algorithm 1 for a rectangle with unit edge directions
+// ex, ey, lengths exl, eyl, corner s, from observer o, and its sample, with
+// the elementary functions F.
 template <class F>
 void ufk13_sample(const ufk13_rect& q, const vec3& o, vec2 u, light_sample& ls) {
   // Set-up: the local reference system and the four inner normals.
@@ -99,9 +99,9 @@ void ufk13_sample(const ufk13_rect& q, const vec3& o, vec2 u, light_sample& ls) 
 
 template <class F>
 void floor_rect(benchmark::State& state) {
-  const rect shape = xz_rect(213, 343, 227, 332, 554, true);
+  const rect shape = bench::cornell_rect_light();
   const ufk13_rect q(shape);
-  const std::vector<vec3> obs = bench::observers_around(shape.center(), shape.n, 130.0f);
+  const std::vector<vec3> obs = bench::observers_around(shape);
   pcg32 rng(1, 2);
   std::size_t i = 0;
   for (auto _ : state) {
@@ -116,13 +116,8 @@ void BM_FloorRectSolidAngleSkeleton(benchmark::State& st) { floor_rect<stand_in_
 BENCHMARK(BM_FloorRectSolidAngleUFK13);
 BENCHMARK(BM_FloorRectSolidAngleSkeleton);
 
-// The canonical cones of the benchmark disk from its observers (set up
-// outside the timed loop).
 void BM_FloorEllipseSolidAngle(benchmark::State& state) {
-  const ellipse light = ellipse::make({278, 554, 279.5}, {65, 0, 0}, {0, 0, 65});
-  std::vector<spherical_ellipse> cones;
-  for (const vec3& o : bench::observers_around(light.center, light.n, 130.0f))
-    cones.push_back(make_ellipse_cone(light, o).se);
+  const std::vector<spherical_ellipse> cones = bench::canonical_cones(bench::cornell_disk_light());
   pcg32 rng(1, 2);
   std::size_t i = 0;
   for (auto _ : state) {

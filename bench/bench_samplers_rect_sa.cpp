@@ -13,9 +13,8 @@
 namespace {
 
 void BM_SampleRectSolidAngle(benchmark::State& state) {
-  const mcrt::rect_solid_angle_sampler sampler{mcrt::xz_rect(213, 343, 227, 332, 554, true)};
-  const std::vector<mcrt::vec3> obs =
-      mcrt::bench::observers_around(sampler.shape.center(), sampler.shape.n, 130.0f);
+  const mcrt::rect_solid_angle_sampler sampler{mcrt::bench::cornell_rect_light()};
+  const std::vector<mcrt::vec3> obs = mcrt::bench::observers_around(sampler.shape);
   mcrt::bench::run_sample_and_pdf(state, sampler, obs);
   std::size_t fast = 0;
   for (const mcrt::vec3& o : obs) fast += sampler.fast_path(o);
@@ -24,8 +23,8 @@ void BM_SampleRectSolidAngle(benchmark::State& state) {
 BENCHMARK(BM_SampleRectSolidAngle);
 
 void BM_SampleRectSolidAngleExact(benchmark::State& state) {
-  const mcrt::rect shape = mcrt::xz_rect(213, 343, 227, 332, 554, true);
-  const std::vector<mcrt::vec3> obs = mcrt::bench::observers_around(shape.center(), shape.n, 130.0f);
+  const mcrt::rect shape = mcrt::bench::cornell_rect_light();
+  const std::vector<mcrt::vec3> obs = mcrt::bench::observers_around(shape);
   mcrt::pcg32 rng(1, 2);
   std::size_t i = 0;
   for (auto _ : state) {

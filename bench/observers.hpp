@@ -1,16 +1,25 @@
 #pragma once
-// What the sampler benchmarks share: observer positions spread around a
-// light, so every sampler is timed on the same set of points, and the timed
-// loop itself (one sample plus its pdf per iteration).
+// What the sampler benchmarks share: the two lights (the Cornell box's
+// ceiling rectangle and a disk of the same size), observer positions spread
+// around a light, so every sampler is timed on the same set of points, and
+// the timed loop itself (one sample plus its pdf per iteration).
 #include <benchmark/benchmark.h>
 
 #include <vector>
 
 #include "mcrt/core/math.hpp"
 #include "mcrt/core/rng.hpp"
+#include "mcrt/geometry/ellipse.hpp"
+#include "mcrt/geometry/rect.hpp"
 #include "mcrt/sampling/light_sample.hpp"
+#include "mcrt/sampling/spherical_ellipse.hpp"
 
 namespace mcrt::bench {
+
+// The benchmark lights: the ceiling light of Shirley's Cornell box (130 x
+// 105, facing down) and a disk of radius 65 at its centre.
+inline rect cornell_rect_light() { return xz_rect(213, 343, 227, 332, 554, true); }
+inline ellipse cornell_disk_light() { return ellipse::make({278, 554, 279.5}, {65, 0, 0}, {0, 0, 65}); }
 
 // n points in front of a light centred at `center` with unit front normal
 // `n`, at distances from 0.2 to 5 times `size`, in all directions of the
@@ -30,6 +39,18 @@ inline std::vector<vec3> observers_around(const vec3& center, const vec3& n, flo
     const float dist = size * (0.2f + 4.8f * rng.uniform());
     out.push_back(center + dist * dir);
   }
+  return out;
+}
+
+// The observers every benchmark of a light uses.
+inline std::vector<vec3> observers_around(const rect& r) { return observers_around(r.center(), r.n, 130.0f); }
+inline std::vector<vec3> observers_around(const ellipse& e) { return observers_around(e.center, e.n, 130.0f); }
+
+// The canonical cones of e from its observers, for the benchmarks of the
+// spherical ellipse's parts (set up outside their timed loops).
+inline std::vector<spherical_ellipse> canonical_cones(const ellipse& e) {
+  std::vector<spherical_ellipse> out;
+  for (const vec3& o : observers_around(e)) out.push_back(make_ellipse_cone(e, o).se);
   return out;
 }
 
