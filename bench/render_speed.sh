@@ -7,7 +7,8 @@
 #   defaults: build/mcrt, 3 runs, scenes/cornell_book3.json
 # Environment: THREADS (default: all hardware threads), STRATEGY (area or
 # solid-angle; default: as each scene file says), ELLIPSE_MAP (parallel or
-# polar: the map of ellipses sampled by solid angle; default parallel).
+# polar: the map of ellipses sampled by solid angle; default parallel),
+# INTEGRATOR (mixture, nee or mis), SAMPLER (independent, stratified, sobol).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 mcrt=${1:-build/mcrt}
@@ -19,11 +20,13 @@ threads=${THREADS:-$(nproc)}
 extra=()
 [ -n "${STRATEGY:-}" ] && extra=(--light-sampling "$STRATEGY")
 [ -n "${ELLIPSE_MAP:-}" ] && extra+=(--ellipse-map "$ELLIPSE_MAP")
+[ -n "${INTEGRATOR:-}" ] && extra+=(--integrator "$INTEGRATOR")
+[ -n "${SAMPLER:-}" ] && extra+=(--sampler "$SAMPLER")
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
-echo "| scene | resolution | spp | threads | light sampling | seconds (best of $runs) | samples/s |"
-echo "|---|---|---|---|---|---|---|"
+echo "| scene | resolution | spp | threads | light sampling | integrator | sampler | seconds (best of $runs) | samples/s |"
+echo "|---|---|---|---|---|---|---|---|---|"
 for scene in "${scenes[@]}"; do
   best=""
   for ((i = 0; i < runs; i++)); do
@@ -38,6 +41,7 @@ for scene in "${scenes[@]}"; do
 import json, sys
 j = json.load(open(sys.argv[1]))
 print(f"| {sys.argv[2]} | {j['width']}x{j['height']} | {j['spp']} | {j['threads']} | {j['light_sampling']} | "
+      f"{j.get('integrator', 'mixture')} | {j.get('sampler', 'independent')} | "
       f"{j['render_seconds']:.2f} | {j['samples_per_second'] / 1e6:.2f} M |")
 PY
 done

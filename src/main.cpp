@@ -18,6 +18,7 @@ using namespace mcrt::cli;
 
 struct render_options {
   std::string scene, output, stats, light_sampling, ellipse_map = "parallel";
+  std::string integrator = "mixture", sampler = "independent", mis_heuristic = "power", light_select = "power";
   std::optional<int> spp, width, height, max_depth, rr_depth;
   std::optional<unsigned> threads;
   std::uint64_t seed = 0;
@@ -92,6 +93,12 @@ int run_render(const render_options& opt) {
   if (opt.rr_depth) rs.rr_depth = *opt.rr_depth;
   rs.seed = opt.seed;
   rs.threads = opt.threads.value_or(0u);
+  rs.integrator = opt.integrator == "nee" ? integrator_kind::nee : opt.integrator == "mis" ? integrator_kind::mis : integrator_kind::mixture;
+  rs.sampler = opt.sampler == "stratified" ? sampler_kind::stratified
+               : opt.sampler == "sobol"    ? sampler_kind::sobol
+                                           : sampler_kind::independent;
+  rs.heuristic = opt.mis_heuristic == "balance" ? mis_heuristic::balance : mis_heuristic::power;
+  rs.choose = opt.light_select == "uniform" ? light_choice::uniform : light_choice::power;
 
   const render_result res = render(ls.world, cam, rs, opt.quiet ? progress_callback{} : progress_callback(print_progress));
   const double samples = static_cast<double>(rs.width) * rs.height * rs.spp;
@@ -106,6 +113,8 @@ int run_render(const render_options& opt) {
                {"mcrt:seed", std::to_string(rs.seed)},
                {"mcrt:light_sampling", strategy_used},
                {"mcrt:ellipse_map", opt.ellipse_map},
+               {"mcrt:integrator", opt.integrator},
+               {"mcrt:sampler", opt.sampler},
                {"mcrt:scene", ls.name}});
   if (!opt.stats.empty()) {
     nlohmann::ordered_json j;
@@ -116,6 +125,10 @@ int run_render(const render_options& opt) {
     j["threads"] = res.threads;
     j["samples_per_second"] = samples / res.seconds;
     j["light_sampling"] = strategy_used;
+    j["integrator"] = opt.integrator;
+    j["sampler"] = opt.sampler;
+    j["mis_heuristic"] = opt.mis_heuristic;
+    j["light_select"] = opt.light_select;
     j["ellipse_map"] = opt.ellipse_map;
     j["seed"] = rs.seed;
     j["max_depth"] = rs.max_depth;
@@ -183,6 +196,17 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--ellipse-map", ro.ellipse_map,
                          "Map of the spherical ellipse for ellipses sampled by solid angle (default parallel)")
       ->check(CLI::IsMember({"parallel", "polar"}));
+  render_cmd->add_option("--integrator", ro.integrator,
+                         "Estimator: mixture (Shirley's mixture pdf, default), nee (next-event estimation) or mis "
+                         "(next-event estimation with multiple importance sampling)")
+      ->check(CLI::IsMember({"mixture", "nee", "mis"}));
+  render_cmd->add_option("--sampler", ro.sampler, "Sample generator: independent, stratified or sobol")
+      ->check(CLI::IsMember({"independent", "stratified", "sobol"}));
+  render_cmd->add_option("--mis-heuristic", ro.mis_heuristic, "Weights of --integrator mis: power (beta = 2, default) or balance")
+      ->check(CLI::IsMember({"power", "balance"}));
+  render_cmd->add_option("--light-select", ro.light_select,
+                         "How nee and mis choose among several lights: power (by emitted flux, default) or uniform")
+      ->check(CLI::IsMember({"power", "uniform"}));
   render_cmd->add_option("--stats", ro.stats, "Write render statistics as JSON to this file");
   render_cmd->add_flag("--quiet", ro.quiet, "No progress line");
 

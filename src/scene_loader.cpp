@@ -200,25 +200,26 @@ std::pair<float, float> interval(const reader& rd, const json& o, const std::str
   return {a, b};
 }
 
-// Adds the light (or importance target) for a shape, with its strategy.
-void add_light(scene& world, const rect& s, light_sampling strategy, ellipse_map) {
+// Adds a directly sampled shape (a light, or an importance target such as
+// book 3's glass sphere) with its strategy: the geometry and the light.
+void add_light(scene& world, const rect& s, std::uint32_t mat, light_sampling strategy, ellipse_map) {
   if (strategy == light_sampling::area)
-    world.lights.emplace_back(rect_area_sampler{s});
+    world.add_light(rect_area_sampler{s}, mat);
   else
-    world.lights.emplace_back(rect_solid_angle_sampler{s});
+    world.add_light(rect_solid_angle_sampler{s}, mat);
 }
-void add_light(scene& world, const ellipse& s, light_sampling strategy, ellipse_map map) {
+void add_light(scene& world, const ellipse& s, std::uint32_t mat, light_sampling strategy, ellipse_map map) {
   if (strategy == light_sampling::area)
-    world.lights.emplace_back(ellipse_area_sampler{s});
+    world.add_light(ellipse_area_sampler{s}, mat);
   else if (map == ellipse_map::polar)
-    world.lights.emplace_back(ellipse_polar_solid_angle_sampler{s});
+    world.add_light(ellipse_polar_solid_angle_sampler{s}, mat);
   else
-    world.lights.emplace_back(ellipse_solid_angle_sampler{s});
+    world.add_light(ellipse_solid_angle_sampler{s}, mat);
 }
 // A sphere is sampled by its cone of directions (uniform in solid angle)
 // under either strategy: there is no area strategy for spheres.
-void add_light(scene& world, const sphere& s, light_sampling, ellipse_map) {
-  world.lights.emplace_back(sphere_cone_sampler{s});
+void add_light(scene& world, const sphere& s, std::uint32_t mat, light_sampling, ellipse_map) {
+  world.add_light(sphere_cone_sampler{s}, mat);
 }
 
 void read_object(const reader& rd, const json& o, const std::string& path, scene& world,
@@ -244,8 +245,10 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
   if (override_strategy) strategy = *override_strategy;
 
   auto add = [&](const auto& shape) {
-    world.add(shape, mat);
-    if (sampled) add_light(world, shape, strategy, map);
+    if (sampled)
+      add_light(world, shape, mat, strategy, map);
+    else
+      world.add(shape, mat);
   };
 
   if (type == "xz_rect" || type == "xy_rect" || type == "yz_rect") {

@@ -113,7 +113,8 @@ TEST_F(Cli, RendersEveryFormatWithStats) {
     EXPECT_TRUE(r.out.empty()) << "nothing but requested data on stdout: " << r.out;
     ASSERT_TRUE(fs::exists(out));
     const auto j = nlohmann::json::parse(slurp(stats));
-    for (const char* key : {"render_seconds", "spp", "width", "height", "threads", "samples_per_second", "light_sampling"})
+    for (const char* key : {"render_seconds", "spp", "width", "height", "threads", "samples_per_second", "light_sampling",
+                            "integrator", "sampler"})
       EXPECT_TRUE(j.contains(key)) << key;
     EXPECT_EQ(j["spp"], 2);
     EXPECT_EQ(j["width"], 16);
@@ -155,6 +156,28 @@ TEST_F(Cli, ProgressGoesToStderrUnlessQuiet) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("100.0%"), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty());
+}
+
+// Every integrator with every sample generator: the same image for any
+// thread count, --stats naming both, and direct light only (--max-depth 1).
+TEST_F(Cli, EveryIntegratorAndSamplerIsDeterministicAcrossThreads) {
+  const fs::path s = write("good.json", scene_with(good_objects()));
+  for (const char* integrator : {"mixture", "nee", "mis"})
+    for (const char* sampler : {"independent", "stratified", "sobol"})
+      for (const char* depth : {"1", "4"}) {
+        const std::string flags = std::string(" --integrator ") + integrator + " --sampler=" + sampler + " --max-depth " + depth +
+                                  " --seed 3 --spp 5 --quiet";
+        const fs::path a = dir / "a.exr", b = dir / "b.exr", stats = dir / "s.json";
+        ASSERT_EQ(run("render " + s.string() + " -o " + a.string() + " --threads 1 --stats " + stats.string() + flags).status, 0);
+        ASSERT_EQ(run("render " + s.string() + " -o " + b.string() + " --threads 3" + flags).status, 0);
+        const result r = run("diff " + a.string() + " " + b.string() + " --json");
+        ASSERT_EQ(r.status, 0) << r.err;
+        EXPECT_EQ(nlohmann::json::parse(r.out)["mse"].get<double>(), 0.0) << flags;
+        const auto j = nlohmann::json::parse(slurp(stats));
+        EXPECT_EQ(j["integrator"], integrator);
+        EXPECT_EQ(j["sampler"], sampler);
+        EXPECT_EQ(j["max_depth"], std::stoi(depth));
+      }
 }
 
 TEST_F(Cli, SameSeedSameImageForAnyThreadCountAndDiffReportsZero) {
@@ -200,6 +223,11 @@ TEST_F(Cli, BadCommandLines) {
   expect_bad(base + "--threads 0", {"--threads"}, out);
   expect_bad(base + "--light-sampling sideways", {"--light-sampling"}, out);
   expect_bad(base + "--ellipse-map round", {"--ellipse-map"}, out);
+  expect_bad(base + "--integrator bidir", {"--integrator"}, out);
+  expect_bad(base + "--integrator", {"--integrator"}, out);
+  expect_bad(base + "--sampler halton", {"--sampler"}, out);
+  expect_bad(base + "--mis-heuristic maximum", {"--mis-heuristic"}, out);
+  expect_bad(base + "--light-select random", {"--light-select"}, out);
   expect_bad(base + "--no-such-flag", {"no-such-flag"}, out);
   expect_bad("render " + (dir / "missing.json").string() + " -o " + out.string(), {"missing.json"}, out);
   expect_bad("frobnicate", {"frobnicate"}, out);
@@ -264,11 +292,13 @@ TEST_F(Cli, BadScenes) {
 TEST_F(Cli, EveryShippedSceneRenders) {
   for (const auto& e : fs::directory_iterator(MCRT_SCENES_DIR)) {
     if (e.path().extension() != ".json") continue;
-    for (const char* strategy : {"area", "solid-angle"}) {
+    // Each integrator with another sample generator.
+    for (const char* strategy : {"area", "solid-angle"})
+      for (const auto& [integrator, sampler] : {std::pair{"mixture", "independent"}, {"nee", "stratified"}, {"mis", "sobol"}}) {
       const fs::path out = dir / (e.path().stem().string() + ".exr"), stats = dir / "s.json";
       const result r = run("render " + e.path().string() + " -o " + out.string() + " --width 24 --height 24 --spp 2 --light-sampling " +
-                           strategy + " --stats " + stats.string() + " --quiet");
-      EXPECT_EQ(r.status, 0) << e.path() << " " << strategy << ": " << r.err;
+                           strategy + " --integrator " + integrator + " --sampler " + sampler + " --stats " + stats.string() + " --quiet");
+      EXPECT_EQ(r.status, 0) << e.path() << " " << strategy << " " << integrator << ": " << r.err;
       if (r.status == 0) {
         const auto j = nlohmann::json::parse(slurp(stats));
         EXPECT_EQ(j["nonfinite_samples"], 0) << e.path();

@@ -53,6 +53,10 @@ inline float schlick(float cosine, float ior) {
   return r0 + (1.0f - r0) * (m * m) * (m * m) * m;
 }
 
+// A point uniform in the unit ball by rejection from the cube [-1, 1]^3
+// (Shirley, "In One Weekend", sec. 8): what the independent sampler's
+// stream gives a metal's fuzz (samplers with a fixed dimension layout use
+// square_to_uniform_ball instead, whose count of numbers is fixed).
 inline vec3 random_in_unit_ball(pcg32& rng) {
   while (true) {
     const vec3 p{2.0f * rng.uniform() - 1.0f, 2.0f * rng.uniform() - 1.0f, 2.0f * rng.uniform() - 1.0f};
@@ -61,25 +65,30 @@ inline vec3 random_in_unit_ball(pcg32& rng) {
 }
 
 // Metal: reflection about the facing normal plus fuzz; absorbed when the
-// fuzzed direction points into the surface.
-inline bool scatter(const metal& m, const ray& in, const hit_record& rec, pcg32& rng, specular_scatter& out) {
+// fuzzed direction points into the surface. ball() gives a point uniform in
+// the unit ball; it is called only when the metal has fuzz.
+template <class Ball>
+inline bool scatter(const metal& m, const ray& in, const hit_record& rec, Ball&& ball, specular_scatter& out) {
   const vec3 n = rec.facing_normal();
   vec3 d = glm::reflect(glm::normalize(in.d), n);
-  if (m.fuzz > 0.0f) d += m.fuzz * random_in_unit_ball(rng);
+  if (m.fuzz > 0.0f) d += m.fuzz * ball();
   out.r = {rec.p, d};
   out.attenuation = m.albedo;
   return glm::dot(d, n) > 0.0f;
 }
 
-// Dielectric: refract or reflect, choosing by the Fresnel reflectance.
-inline bool scatter(const dielectric& m, const ray& in, const hit_record& rec, pcg32& rng, specular_scatter& out) {
+// Dielectric: refract or reflect, choosing by the Fresnel reflectance. u()
+// gives a number uniform in [0, 1) for that choice; it is called only when
+// there is a choice (not under total internal reflection).
+template <class U>
+inline bool scatter(const dielectric& m, const ray& in, const hit_record& rec, U&& u, specular_scatter& out) {
   const float eta = rec.front_face ? (1.0f / m.ior) : m.ior;
   const vec3 unit = glm::normalize(in.d);
   const vec3 n = rec.facing_normal();
   const float cos_t = std::min(glm::dot(-unit, n), 1.0f);
   const float sin2_t = 1.0f - cos_t * cos_t;
   vec3 d;
-  if (eta * eta * sin2_t > 1.0f || schlick(cos_t, m.ior) > rng.uniform()) {
+  if (eta * eta * sin2_t > 1.0f || schlick(cos_t, m.ior) > u()) {
     d = glm::reflect(unit, n);
   } else {
     // Snell: perpendicular and parallel parts of the refracted direction.

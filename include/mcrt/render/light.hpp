@@ -36,4 +36,15 @@ inline float pdf(const light& l, const vec3& o, const vec3& dir) {
   return dispatch(l, [&](const auto& s) { return s.pdf(o, dir); });
 }
 
+// Surface area of a light's shape (the whole sphere for a sphere).
+inline float surface_area(const rect& r) { return r.area; }
+inline float surface_area(const ellipse& e) { return e.area; }
+inline float surface_area(const sphere& s) { return 2.0f * two_pi * s.radius * s.radius; }
+inline float surface_area(const light& l) {
+  return dispatch(l, [](const auto& s) { return surface_area(s.shape); });
+}
+
+// Luminance of a linear Rec. 709 colour (ITU-R BT.709 Y weights).
+inline float luminance(const color& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
+
 }  // namespace mcrt

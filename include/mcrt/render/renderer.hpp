@@ -1,9 +1,14 @@
 #pragma once
-// Renders a scene through a camera: 16x16 tiles handed to all threads from
-// an atomic counter; every pixel has its own PCG32 stream seeded from (seed,
-// pixel index), so an image is bit-identical whatever the thread count.
-// Pixel samples are stratified: the first floor(sqrt(spp))^2 samples jitter
-// one per cell of a square grid, the rest are uniform in the pixel.
+// Renders a scene through a camera with one integrator and one sample
+// generator: 16x16 tiles handed to all threads from an atomic counter; every
+// pixel's numbers depend only on (seed, pixel, sample index, dimension), so
+// an image is bit-identical whatever the thread count. Each camera sample
+// is a ray through the point of the pixel the sampler gives (dimensions 0
+// and 1), and the pixel's value is the mean of its samples (box filter).
+//
+// render_with<Integrator, Sampler> is the statically dispatched core; render()
+// picks the pair named in render_settings at run time, so a program pays only
+// for one branch per image.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -15,6 +20,7 @@
 #include "mcrt/render/camera.hpp"
 #include "mcrt/render/image.hpp"
 #include "mcrt/render/path_tracer.hpp"
+#include "mcrt/samplers/samplers.hpp"
 
 namespace mcrt {
 
@@ -25,6 +31,12 @@ struct render_settings {
   int rr_depth = 1;  // see path_settings
   std::uint64_t seed = 0;
   unsigned threads = 0;  // 0: all hardware threads
+  integrator_kind integrator = integrator_kind::mixture;
+  sampler_kind sampler = sampler_kind::independent;
+  light_choice choose = light_choice::power;       // nee, mis (path_settings)
+  mis_heuristic heuristic = mis_heuristic::power;  // mis (path_settings)
+
+  path_settings path() const { return {max_depth, rr_depth, choose, heuristic}; }
 };
 
 struct render_result {
@@ -38,26 +50,18 @@ struct render_result {
 // about every `progress_interval`, and once at the end.
 using progress_callback = std::function<void(double, double)>;
 
-// The RNG of one pixel: seed and pixel index decorrelated by a 64-bit mix.
-inline pcg32 pixel_rng(std::uint64_t seed, std::uint64_t pixel_index) {
-  return pcg32(mix64(pixel_index ^ mix64(seed)), mix64(seed + 0x632be59bd9b4e019ULL));
-}
-
-template <class Scene>
-color render_pixel(const Scene& sc, const camera& cam, const render_settings& rs, int x, int y,
+template <class Integrator, class Scene, class Sampler>
+color render_pixel(const Scene& sc, const camera& cam, const render_settings& rs, const Sampler& sampler, int x, int y,
                    std::uint64_t& nonfinite) {
-  pcg32 rng = pixel_rng(rs.seed, static_cast<std::uint64_t>(y) * static_cast<std::uint64_t>(rs.width) +
-                                     static_cast<std::uint64_t>(x));
-  const int strata = static_cast<int>(std::sqrt(static_cast<double>(rs.spp)));
-  const float inv_strata = 1.0f / static_cast<float>(std::max(strata, 1));
+  auto ps = sampler.start_pixel(x, y, rs.width);
   const float inv_w = 1.0f / static_cast<float>(rs.width), inv_h = 1.0f / static_cast<float>(rs.height);
-  const path_settings ps{rs.max_depth, rs.rr_depth};
+  const path_settings set = rs.path();
   glm::dvec3 sum(0.0);
   for (int s = 0; s < rs.spp; ++s) {
-    vec2 j = rng.uniform2();
-    if (s < strata * strata) j = (vec2(static_cast<float>(s % strata), static_cast<float>(s / strata)) + j) * inv_strata;
+    ps.start_sample(s);
+    const vec2 j = ps.pixel();
     const ray r = cam.generate((static_cast<float>(x) + j.x) * inv_w, (static_cast<float>(y) + j.y) * inv_h);
-    const color c = trace_path(sc, r, rng, ps);
+    const color c = Integrator::li(sc, r, ps, set);
     if (all_finite(c))
       sum += glm::dvec3(c);
     else
@@ -66,10 +70,11 @@ color render_pixel(const Scene& sc, const camera& cam, const render_settings& rs
   return color(sum / static_cast<double>(rs.spp));
 }
 
-template <class Scene>
-render_result render(const Scene& sc, const camera& cam, const render_settings& rs,
-                     const progress_callback& progress = {},
-                     std::chrono::milliseconds progress_interval = std::chrono::milliseconds(250)) {
+template <class Integrator, class Sampler, class Scene>
+render_result render_with(const Scene& sc, const camera& cam, const render_settings& rs,
+                          const progress_callback& progress = {},
+                          std::chrono::milliseconds progress_interval = std::chrono::milliseconds(250)) {
+  const Sampler sampler(rs.seed, rs.spp);
   constexpr int tile = 16;
   render_result out;
   out.img = image(rs.width, rs.height);
@@ -87,7 +92,7 @@ render_result render(const Scene& sc, const camera& cam, const render_settings& 
       const int x0 = (t % tiles_x) * tile, y0 = (t / tiles_x) * tile;
       const int x1 = std::min(x0 + tile, rs.width), y1 = std::min(y0 + tile, rs.height);
       for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x) out.img.at(x, y) = render_pixel(sc, cam, rs, x, y, bad);
+        for (int x = x0; x < x1; ++x) out.img.at(x, y) = render_pixel<Integrator>(sc, cam, rs, sampler, x, y, bad);
       done.fetch_add(1, std::memory_order_release);
     }
     nonfinite.fetch_add(bad, std::memory_order_relaxed);
@@ -113,6 +118,16 @@ render_result render(const Scene& sc, const camera& cam, const render_settings& 
   out.nonfinite_samples = nonfinite.load();
   if (progress) progress(1.0, out.seconds);
   return out;
+}
+
+// The integrator and sampler named in rs, dispatched once per image.
+template <class Scene>
+render_result render(const Scene& sc, const camera& cam, const render_settings& rs,
+                     const progress_callback& progress = {},
+                     std::chrono::milliseconds progress_interval = std::chrono::milliseconds(250)) {
+  return with_integrator(rs.integrator, [&]<class I>() {
+    return with_sampler(rs.sampler, [&]<class S>() { return render_with<I, S>(sc, cam, rs, progress, progress_interval); });
+  });
 }
 
 }  // namespace mcrt

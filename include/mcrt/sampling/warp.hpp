@@ -36,6 +36,20 @@ inline vec2 uniform_sphere_to_square(const vec3& d) {
   return {0.5f * (1.0f - d.z), phi / two_pi};
 }
 
+// --- uniform ball: radius cbrt(u0) (the volume inside radius r is r^3 of
+// the ball's), direction uniform on the sphere from u.
+inline vec3 square_to_uniform_ball(float u0, vec2 u) { return std::cbrt(u0) * square_to_uniform_sphere(u); }
+// Density per unit VOLUME: 3 / (4 pi) inside the unit ball.
+inline float square_to_uniform_ball_pdf(const vec3& p) {
+  return glm::dot(p, p) < 1.0f ? 0.75f * inv_pi : 0.0f;
+}
+// (u0, u) of a point inside the ball (the origin maps to u0 = 0, u = (0.5, 0)).
+inline void uniform_ball_to_cube(const vec3& p, float& u0, vec2& u) {
+  const float r = glm::length(p);
+  u0 = r * r * r;
+  u = r > 0.0f ? uniform_sphere_to_square(p / r) : vec2(0.5f, 0.0f);
+}
+
 // --- uniform cone of half-angle theta_max around +z, given as
 // one_minus_cos = 1 - cos(theta_max), which stays accurate for narrow cones.
 inline vec3 square_to_uniform_cone(vec2 u, float one_minus_cos) {

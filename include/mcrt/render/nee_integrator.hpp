@@ -1,0 +1,132 @@
+#pragma once
+// Next-event estimation (pbrt-v4's PathIntegrator without the BSDF-side
+// weight; Veach 1997, sec. 9.2 and 10.3): at each diffuse bounce one light
+// sample, checked by a shadow ray, gives the direct light, and the path
+// continues with a sample of the material's pdf. Emission that continuation
+// meets is not counted again; camera rays and specular bounces, which no
+// light sample can reproduce, still see emission.
+//
+// The loop is written once, as next_event_integrator<Weights>, for this
+// estimator and for mis_integrator.hpp: both are multiple importance
+// sampling of two techniques (the light sample and the material's sample)
+// with different weights. Here the light sample takes weight 1 wherever it
+// could have drawn the direction, and the material's sample takes the rest:
+// weight 1 only where no light sample reaches (an emitter that is not in the
+// scene's list of lights, a direction where every light's pdf is 0), so the
+// estimate stays unbiased whatever the scene holds.
+//
+// The shadow ray is a closest-hit query and the light sample counts the
+// radiance of whatever front side of an emitter it meets first, divided by
+// the density of the whole technique p_L (light_selection.hpp): correct with
+// several lights, one in front of another.
+//
+// Dimensions (samplers/layout.hpp) at bounce b: the light choice (drawn
+// only when the scene has more than one emitter), the light sample, the
+// roulette, then the material sample.
+#include "mcrt/render/path.hpp"
+
+namespace mcrt {
+
+// Weights of plain next-event estimation: the light sample where it can
+// reach, the material's sample elsewhere.
+struct light_sample_weights {
+  // The material's sample counts emission only where no light sample reaches.
+  static constexpr bool material_counts_listed_lights = false;
+  static float light(const path_settings&, float p_light, float /*p_material*/) { return p_light > 0.0f ? 1.0f : 0.0f; }
+  static float material(const path_settings&, float /*p_material*/, float p_light) { return p_light > 0.0f ? 0.0f : 1.0f; }
+};
+
+// One light sample from the diffuse point p (facing normal n, albedo)
+// towards the light chosen by sel: the radiance it brings, times the
+// lambertian BSDF and the cosine, over the technique's density, with the
+// light technique's weight. Zero when nothing is chosen, the sample is
+// below the surface or the shadow ray meets no emitter's front side.
+template <class Weights, class Scene, class P>
+color sample_direct_light(const Scene& sc, const vec3& p, const vec3& n, const color& albedo,
+                          const light_selection& sel, P& ps, int b, const path_settings& set) {
+  if (sel.empty()) return color(0.0f);
+  float prob = 0.0f;
+  const std::ptrdiff_t k = sel.pick(sel.needs_choice() ? ps.get1d(b + layout::light_choice) : 0.0f, prob);
+  if (k < 0) return color(0.0f);
+  light_sample s;
+  if (!sample(sc.lights[static_cast<std::size_t>(k)], p, ps.get2d(b + layout::light), s)) return color(0.0f);
+  const float cos_theta = glm::dot(s.dir, n);
+  if (!(cos_theta > 0.0f)) return color(0.0f);
+  const float p_light = sel.pdf(s.dir, k, s.pdf);
+  if (!(p_light > 0.0f) || !std::isfinite(p_light)) return color(0.0f);
+  hit_record srec;
+  if (!sc.hit(ray{p, s.dir}, sc.ray_epsilon, infinity, srec)) return color(0.0f);
+  const color le = emitted(sc.materials[srec.material], srec);
+  if (le == color(0.0f)) return color(0.0f);
+  const float w = Weights::light(set, p_light, cos_theta * inv_pi);
+  return le * albedo * (cos_theta * inv_pi * w / p_light);
+}
+
+template <class Weights>
+struct next_event_integrator {
+  template <class Scene, class P>
+  static color li(const Scene& sc, ray r, P& ps, const path_settings& set) {
+    color radiance(0.0f), throughput(1.0f);
+    // After a diffuse bounce: the light selection at that point and the
+    // density of the direction the material sampled, for the weight of the
+    // emission the direction meets.
+    bool after_diffuse = false;
+    light_selection prev_sel(sc, vec3(0.0f), set.choose);
+    float prev_p_material = 0.0f;
+    for (int depth = 0;; ++depth) {
+      hit_record rec;
+      if (!sc.hit(r, sc.ray_epsilon, infinity, rec)) {
+        radiance += throughput * sc.background;
+        break;
+      }
+      const material& m = sc.materials[rec.material];
+      if (const auto* l = std::get_if<diffuse_light>(&m)) {
+        if (rec.front_face) {
+          const float w = after_diffuse ? Weights::material(set, prev_p_material, prev_sel.pdf(r.d)) : 1.0f;
+          radiance += throughput * l->emit * w;
+        }
+        break;
+      }
+      if (depth == set.max_depth) break;
+      const int b = layout::bounce(depth);
+
+      if (const auto* lam = std::get_if<lambertian>(&m)) {
+        const vec3 n = rec.facing_normal();
+        const light_selection sel(sc, rec.p, set.choose);
+        radiance += throughput * sample_direct_light<Weights>(sc, rec.p, n, lam->albedo, sel, ps, b, set);
+        if (depth >= set.rr_depth && !survive_roulette(throughput, [&] { return ps.get1d(b + layout::roulette); }))
+          break;
+        // The last scattering event of a plain next-event estimator: the
+        // continuation could only meet the background or an emitter no
+        // light sample reaches; when the scene has neither, it is not traced.
+        if constexpr (!Weights::material_counts_listed_lights)
+          if (depth + 1 == set.max_depth && sc.background == color(0.0f) && sc.unsampled_emitters == 0) break;
+        const vec3 dir = cosine_pdf(n).generate(ps.get2d(b + layout::material));
+        const float cos_theta = glm::dot(dir, n);
+        if (!(cos_theta > 0.0f)) break;
+        // f cos / p = (albedo / pi) cos / (cos / pi)
+        throughput *= lam->albedo;
+        after_diffuse = true;
+        prev_sel = sel;
+        prev_p_material = cos_theta * inv_pi;
+        r = {rec.p, dir};
+        continue;
+      }
+
+      if (depth >= set.rr_depth && !survive_roulette(throughput, [&] { return ps.get1d(b + layout::roulette); }))
+        break;
+      specular_scatter sp;
+      if (!scatter_specular(m, r, rec, ps, b, sp)) break;
+      throughput *= sp.attenuation;
+      after_diffuse = false;
+      r = sp.r;
+    }
+    return radiance;
+  }
+};
+
+struct nee_integrator : next_event_integrator<light_sample_weights> {
+  static constexpr const char* name = "nee";
+};
+
+}  // namespace mcrt

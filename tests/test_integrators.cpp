@@ -1,0 +1,353 @@
+// The three integrators (mixture, nee, mis) against each other and their
+// parts: the multiple importance sampling weights of the two techniques sum
+// to 1 for every direction, the light selection's probabilities and
+// densities agree with what it samples, the next-event estimators stay
+// unbiased when an emitter is not in the list of lights, and on the seed's
+// Cornell scenes (global and direct light only) every integrator and sample
+// generator gives the same mean image.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "mcrt/mcrt.hpp"
+#include "support/lambert.hpp"
+#ifdef MCRT_HAVE_SCENE_LOADER
+#include "scene_loader.hpp"
+#endif
+
+using namespace mcrt;
+
+namespace {
+
+// A random light of every kind and strategy, facing roughly towards -y,
+// around height 1 above the origin.
+light random_light(pcg32& rng, int kind) {
+  const vec3 c{rng.uniform() - 0.5f, 0.6f + rng.uniform(), rng.uniform() - 0.5f};
+  const float a = 0.05f + 0.5f * rng.uniform(), b = 0.05f + 0.5f * rng.uniform();
+  const float t = two_pi * rng.uniform();
+  const vec3 e1{a * std::cos(t), 0.0f, a * std::sin(t)}, e2{-b * std::sin(t), 0.0f, b * std::cos(t)};
+  switch (kind % 6) {
+    case 0: return rect_area_sampler{rect::make(c, e1, e2)};  // e1 x e2 points down
+    case 1: return rect_solid_angle_sampler{rect::make(c, e1, e2)};
+    case 2: return ellipse_area_sampler{ellipse::make(c, e1, e2)};
+    case 3: return ellipse_solid_angle_sampler{ellipse::make(c, e1, e2)};
+    case 4: return ellipse_polar_solid_angle_sampler{ellipse::make(c, e1, e2)};
+    default: return sphere_cone_sampler{sphere{c, 0.5f * a}};
+  }
+}
+
+}  // namespace
+
+// For a direction drawn by the light technique, the weight the integrator
+// gives it (from the density returned with the sample) and the weight the
+// material's technique would give the same direction (from the lights' pdf
+// evaluated afresh) sum to 1, for both heuristics and for plain next-event
+// estimation; with several lights chosen by power or uniformly, and with
+// every light strategy. 20000 random configurations.
+TEST(MisWeights, SumToOneForRandomConfigurations) {
+  pcg32 rng(2024, 5);
+  int checked = 0;
+  for (int config = 0; config < 20000; ++config) {
+    std::vector<light> lights;
+    std::vector<emitter> emitters;
+    const int count = 1 + static_cast<int>(rng.uniform() * 3.0f);
+    for (int i = 0; i < count; ++i) {
+      lights.push_back(random_light(rng, static_cast<int>(rng.uniform() * 6.0f)));
+      emitters.push_back({static_cast<std::uint32_t>(i), 0.1f + rng.uniform()});
+    }
+    const vec3 o{2.0f * rng.uniform() - 1.0f, 0.0f, 2.0f * rng.uniform() - 1.0f};
+    const vec3 n = glm::normalize(vec3{rng.uniform() - 0.5f, 1.0f, rng.uniform() - 0.5f});
+    const light_choice how = rng.uniform() < 0.5f ? light_choice::power : light_choice::uniform;
+    const light_selection sel(lights, emitters, o, how);
+    if (sel.empty()) continue;
+    float prob = 0.0f;
+    const std::ptrdiff_t k = sel.pick(rng.uniform(), prob);
+    ASSERT_GE(k, 0);
+    EXPECT_FLOAT_EQ(prob, sel.probability(static_cast<std::size_t>(k)));
+    light_sample s;
+    if (!sample(lights[static_cast<std::size_t>(k)], o, rng.uniform2(), s)) continue;
+    const float cos_theta = glm::dot(s.dir, n);
+    if (!(cos_theta > 0.0f)) continue;
+    const float p_material = cos_theta * inv_pi;
+    const float p_light_sampled = sel.pdf(s.dir, k, s.pdf);  // as the light sample computes it
+    const float p_light_evaluated = sel.pdf(s.dir);          // as the material's sample computes it
+    ASSERT_GT(p_light_evaluated, 0.0f) << "a sampled direction must have a positive density";
+    for (const mis_heuristic h : {mis_heuristic::power, mis_heuristic::balance}) {
+      const path_settings set{50, 1, how, h};
+      const float sum = heuristic_weights::light(set, p_light_sampled, p_material) +
+                        heuristic_weights::material(set, p_material, p_light_evaluated);
+      EXPECT_NEAR(sum, 1.0f, 1e-4f) << "config " << config << " p_light " << p_light_sampled << " vs "
+                                    << p_light_evaluated << " p_material " << p_material;
+    }
+    const path_settings set{};
+    EXPECT_EQ(light_sample_weights::light(set, p_light_sampled, p_material) +
+                  light_sample_weights::material(set, p_material, p_light_evaluated),
+              1.0f);
+    ++checked;
+  }
+  EXPECT_GT(checked, 10000);
+}
+
+TEST(MisWeights, HeuristicsAreTheirFormulas) {
+  EXPECT_FLOAT_EQ(power_heuristic(2.0f, 1.0f), 4.0f / 5.0f);
+  EXPECT_FLOAT_EQ(balance_heuristic(2.0f, 1.0f), 2.0f / 3.0f);
+  EXPECT_EQ(power_heuristic(0.0f, 1.0f), 0.0f);
+  EXPECT_EQ(power_heuristic(1.0f, 0.0f), 1.0f);
+  // Densities of tiny lights: no overflow when squared.
+  EXPECT_FLOAT_EQ(power_heuristic(1e30f, 1.0f), 1.0f);
+  EXPECT_FLOAT_EQ(power_heuristic(1.0f, 1e30f) + power_heuristic(1e30f, 1.0f), 1.0f);
+  EXPECT_EQ(power_heuristic(1.0f, infinity), 0.0f);
+}
+
+// Lights are chosen with the probabilities the selection reports: by power
+// (flux) or uniformly, among the emitters that face the point only.
+// Chi-square goodness of fit, 3 degrees of freedom, 1e-4 significance.
+TEST(LightSelection, ChoosesWithTheStatedProbabilities) {
+  std::vector<light> lights;
+  std::vector<emitter> emitters;
+  for (int i = 0; i < 5; ++i) {
+    const rect r = xz_rect(-1.0f + 0.4f * i, -0.8f + 0.4f * i, -0.1f, 0.1f, 2.0f, /*flip=*/i != 2);  // light 2 faces up
+    lights.push_back(rect_area_sampler{r});
+    emitters.push_back({static_cast<std::uint32_t>(i), 1.0f + static_cast<float>(i)});
+  }
+  const vec3 o{0.0f, 0.0f, 0.0f};
+  for (const light_choice how : {light_choice::power, light_choice::uniform}) {
+    const light_selection sel(lights, emitters, o, how);
+    EXPECT_EQ(sel.probability(2), 0.0f) << "a light seen from behind is never chosen";
+    double total = 0.0;
+    for (std::size_t k = 0; k < 5; ++k) total += sel.probability(k);
+    EXPECT_NEAR(total, 1.0, 1e-6);
+    if (how == light_choice::power) EXPECT_NEAR(sel.probability(4), 5.0 / (1 + 2 + 4 + 5), 1e-6);
+    if (how == light_choice::uniform) EXPECT_NEAR(sel.probability(4), 0.25, 1e-6);
+    std::map<std::ptrdiff_t, int> counts;
+    pcg32 rng(7, 7);
+    const int n = 200000;
+    for (int i = 0; i < n; ++i) {
+      float p;
+      ++counts[sel.pick(rng.uniform(), p)];
+    }
+    EXPECT_EQ(counts.count(2), 0u);
+    EXPECT_EQ(counts.count(-1), 0u);
+    double chi2 = 0.0;
+    for (std::size_t k : {0u, 1u, 3u, 4u}) {
+      const double expected = n * sel.probability(k);
+      chi2 += (counts[static_cast<std::ptrdiff_t>(k)] - expected) * (counts[static_cast<std::ptrdiff_t>(k)] - expected) / expected;
+    }
+    EXPECT_LT(chi2, 21.1) << "chi-square quantile 1 - 1e-4 with 3 degrees of freedom is 21.1";
+  }
+}
+
+TEST(LightSelection, NonEmittingImportanceTargetsAreNotEmitters) {
+  scene sc;
+  sc.materials = {lambertian{color(0.5f)}, diffuse_light{color(4.0f)}, dielectric{1.5f}};
+  sc.add_light(rect_area_sampler{xz_rect(-1, 1, -1, 1, 2, true)}, 1);
+  sc.add_light(sphere_cone_sampler{sphere{{0, 1, 0}, 0.3f}}, 2);  // book 3's glass sphere
+  EXPECT_EQ(sc.lights.size(), 2u);
+  ASSERT_EQ(sc.emitters.size(), 1u);
+  EXPECT_EQ(sc.emitters[0].light, 0u);
+  EXPECT_NEAR(sc.emitters[0].power, pi * 4.0f * 4.0f, 1e-3f);  // pi * area * luminance
+}
+
+namespace {
+
+// Mean and standard error of the mean over replicates of a scalar.
+struct replicated {
+  double mean = 0.0, stderr_ = 0.0;
+};
+
+replicated summarise(const std::vector<double>& v) {
+  double s = 0.0, s2 = 0.0;
+  for (double x : v) s += x, s2 += x * x;
+  const double n = static_cast<double>(v.size());
+  const double m = s / n;
+  return {m, std::sqrt(std::max(s2 / n - m * m, 0.0) / (n - 1.0))};
+}
+
+double image_mean(const image& img) {
+  double s = 0.0;
+  for (const color& c : img.pixels) s += static_cast<double>(c.r) + c.g + c.b;
+  return s / (3.0 * static_cast<double>(img.pixels.size()));
+}
+
+// The image mean of `replicates` renders with seeds 1..replicates.
+template <class Scene>
+replicated mean_image(const Scene& sc, const camera& cam, render_settings rs, int replicates) {
+  std::vector<double> means;
+  for (int r = 0; r < replicates; ++r) {
+    rs.seed = static_cast<std::uint64_t>(1000 + r);
+    means.push_back(image_mean(render(sc, cam, rs).img));
+  }
+  return summarise(means);
+}
+
+struct config {
+  integrator_kind integrator;
+  sampler_kind sampler;
+  light_choice choose = light_choice::power;
+};
+
+std::string describe(const config& c) {
+  return std::string(to_string(c.integrator)) + "/" + std::string(to_string(c.sampler)) +
+         (c.choose == light_choice::uniform ? "/uniform" : "");
+}
+
+// Every configuration's mean image against the mixture's with the
+// independent sampler: Welch's statistic |m_a - m_b| / sqrt(se_a^2 + se_b^2)
+// <= 5 with 24 replicates each (about 46 degrees of freedom: two-sided
+// false-failure probability 1e-5 per comparison).
+template <class Scene>
+void expect_same_mean(const Scene& sc, const camera& cam, render_settings rs, const std::vector<config>& configs,
+                      const std::string& what) {
+  constexpr int replicates = 24;
+  rs.integrator = integrator_kind::mixture;
+  rs.sampler = sampler_kind::independent;
+  const replicated ref = mean_image(sc, cam, rs, replicates);
+  ASSERT_GT(ref.mean, 0.0) << what;
+  for (const config& c : configs) {
+    rs.integrator = c.integrator;
+    rs.sampler = c.sampler;
+    rs.choose = c.choose;
+    const replicated m = mean_image(sc, cam, rs, replicates);
+    const double z = std::abs(m.mean - ref.mean) / std::sqrt(m.stderr_ * m.stderr_ + ref.stderr_ * ref.stderr_);
+    EXPECT_LE(z, 5.0) << what << ": " << describe(c) << " mean " << m.mean << " +- " << m.stderr_ << ", mixture "
+                      << ref.mean << " +- " << ref.stderr_;
+  }
+}
+
+const std::vector<config> all_configs{
+    {integrator_kind::nee, sampler_kind::independent},  {integrator_kind::mis, sampler_kind::independent},
+    {integrator_kind::mixture, sampler_kind::sobol},     {integrator_kind::nee, sampler_kind::stratified},
+    {integrator_kind::mis, sampler_kind::sobol},         {integrator_kind::mis, sampler_kind::stratified},
+    {integrator_kind::nee, sampler_kind::sobol},         {integrator_kind::mixture, sampler_kind::stratified}};
+
+}  // namespace
+
+// Two lights, one in front of the other and brighter, a third facing away,
+// and an emitter that is not in the list of lights: the next-event
+// estimators must count the light of whatever emitter a shadow ray meets
+// with the density of the whole technique, and the unlisted emitter through
+// the material's sample. Both ways of choosing a light.
+TEST(Integrators, AgreeOnOverlappingAndUnlistedLights) {
+  scene sc;
+  sc.materials = {lambertian{color(0.6f)}, diffuse_light{color(3.0f)}, diffuse_light{color(10.0f, 8.0f, 6.0f)},
+                  diffuse_light{color(2.0f)}};
+  sc.add(xz_rect_shape{-3, 3, -3, 3, 0}, 0);                                      // floor
+  sc.add(yz_rect_shape{0, 3, -3, 3, -3}, 0);                                      // a wall
+  sc.add_light(rect_solid_angle_sampler{xz_rect(-1, 1, -1, 1, 2, true)}, 1);      // large, behind
+  sc.add_light(ellipse_area_sampler{ellipse::make({0.2f, 1.5f, 0}, {0.3f, 0, 0}, {0, 0, 0.3f})}, 2);  // small, in front
+  sc.add_light(rect_area_sampler{xz_rect(1.5f, 2.5f, -1, 1, 2.5f, false)}, 1);    // faces up: never seen from below
+  sc.add(sphere{{-1.5f, 0.5f, 0.5f}, 0.4f}, 3);                                    // emits, not listed
+  sc.ray_epsilon = 1e-4f;
+  const camera cam({0, 1.2f, -4}, {0, 0.6f, 0}, {0, 1, 0}, 60, 1.0f);
+  render_settings rs;
+  rs.width = rs.height = 20;
+  rs.spp = 16;
+  rs.max_depth = 3;
+  std::vector<config> configs = all_configs;
+  configs.push_back({integrator_kind::nee, sampler_kind::independent, light_choice::uniform});
+  configs.push_back({integrator_kind::mis, sampler_kind::sobol, light_choice::uniform});
+  expect_same_mean(sc, cam, rs, configs, "overlapping lights");
+}
+
+#ifdef MCRT_HAVE_SCENE_LOADER
+// The seed's Cornell scenes and book 3's (glass sphere sampled by the
+// mixture only) and the materials scene (metal with fuzz, glass): global
+// illumination and direct light only (--max-depth 1), both light strategies.
+TEST(Integrators, AgreeInMeanOnTheCornellScenes) {
+  for (const char* name :
+       {"cornell_rect", "cornell_rect_large", "cornell_disk", "cornell_disk_large", "cornell_book3", "cornell_materials"}) {
+    for (const light_sampling strategy : {light_sampling::area, light_sampling::solid_angle}) {
+      const cli::loaded_scene ls = cli::load_scene(std::string(MCRT_SCENES_DIR) + "/" + name + ".json", strategy);
+      const camera cam(ls.cam.lookfrom, ls.cam.lookat, ls.cam.vup, ls.cam.vfov,
+                       static_cast<float>(ls.cam.width) / static_cast<float>(ls.cam.height));
+      render_settings rs;
+      rs.width = rs.height = 16;
+      rs.spp = 16;
+      for (const int depth : {1, ls.max_depth}) {
+        rs.max_depth = depth;
+        expect_same_mean(ls.world, cam, rs, all_configs,
+                         std::string(name) + (strategy == light_sampling::area ? " area" : " solid-angle") +
+                             " max depth " + std::to_string(depth));
+      }
+    }
+  }
+}
+#endif
+
+// Direct light only under next-event estimation on the unoccluded floor
+// under a rectangle, against Lambert's formula: with the Sobol generator the
+// root-mean-square error over 64 floor points x 8 replicates falls at least
+// as fast as N^-0.75 over N = 4 ... 256 samples (least-squares slope of log
+// RMSE on log N <= -0.75; Owen-scrambled nets give about N^-1.5 for this
+// smooth integrand), and with the independent one like N^-0.5 (slope within
+// -0.5 +- 0.1: with 512 squared errors per N the RMSE is known to ~6 %, so
+// the slope over a 64-fold range of N to about +-0.03).
+namespace {
+
+double floor_rmse(sampler_kind sk, light_sampling strategy, int n) {
+  const float albedo = 0.5f, emit = 4.0f, h = 1.0f;
+  scene sc;
+  sc.materials = {lambertian{color(albedo)}, diffuse_light{color(emit)}};
+  sc.add(xz_rect_shape{-50, 50, -50, 50, 0}, 0);
+  sc.ray_epsilon = 1e-4f;
+  const rect lr = xz_rect(-0.3f, 0.3f, -0.2f, 0.2f, h, true);
+  if (strategy == light_sampling::area)
+    sc.add_light(rect_area_sampler{lr}, 1);
+  else
+    sc.add_light(rect_solid_angle_sampler{lr}, 1);
+  const std::vector<glm::dvec3> poly{{-0.3, h, -0.2}, {0.3, h, -0.2}, {0.3, h, 0.2}, {-0.3, h, 0.2}};
+  const path_settings set{1, 3};
+  return with_sampler(sk, [&]<class S>() {
+    const S sampler(77, n);
+    double se = 0.0;
+    int count = 0;
+    for (int pt = 0; pt < 64; ++pt) {
+      const float x = -1.0f + 2.0f * static_cast<float>(pt % 8) / 7.0f, z = -1.0f + 2.0f * static_cast<float>(pt / 8) / 7.0f;
+      const double exact = albedo / std::numbers::pi * test::polygon_irradiance({x, 0.0, z}, {0.0, 1.0, 0.0}, poly, emit);
+      for (int rep = 0; rep < 8; ++rep) {
+        auto ps = sampler.start_pixel(pt, rep, 64);
+        double sum = 0.0;
+        for (int i = 0; i < n; ++i) {
+          ps.start_sample(i);
+          sum += nee_integrator::li(sc, ray{{x, 0.5f, z}, {0, -1, 0}}, ps, set).r;
+        }
+        const double rel = (sum / n - exact) / exact;
+        se += rel * rel;
+        ++count;
+      }
+    }
+    return std::sqrt(se / count);
+  });
+}
+
+double loglog_slope(const std::vector<double>& x, const std::vector<double>& y) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  const double n = static_cast<double>(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double lx = std::log(x[i]), ly = std::log(y[i]);
+    sx += lx, sy += ly, sxx += lx * lx, sxy += lx * ly;
+  }
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+}  // namespace
+
+TEST(Convergence, SobolBeatsNToTheMinusThreeQuartersOnDirectLight) {
+  for (const light_sampling strategy : {light_sampling::area, light_sampling::solid_angle}) {
+    std::vector<double> ns, sobol, independent;
+    for (int n = 4; n <= 256; n *= 2) {
+      ns.push_back(n);
+      sobol.push_back(floor_rmse(sampler_kind::sobol, strategy, n));
+      independent.push_back(floor_rmse(sampler_kind::independent, strategy, n));
+    }
+    const double s_sobol = loglog_slope(ns, sobol), s_indep = loglog_slope(ns, independent);
+    const char* what = strategy == light_sampling::area ? "area" : "solid-angle";
+    EXPECT_LE(s_sobol, -0.75) << what << ": sobol RMSE slope " << s_sobol;
+    EXPECT_NEAR(s_indep, -0.5, 0.1) << what << ": independent RMSE slope " << s_indep;
+    std::printf("%s: RMSE slope sobol %.3f, independent %.3f (RMSE at 256: %.3g vs %.3g)\n", what, s_sobol, s_indep,
+                sobol.back(), independent.back());
+  }
+}
