@@ -72,6 +72,9 @@ int run_render(const render_options& opt) {
   check_range(opt.rr_depth, "--rr-depth", 0, max_depth_limit);
   if (opt.threads && *opt.threads == 0) throw input_error("--threads: must be >= 1");
   std::optional<light_sampling> strategy;
+  if (opt.light_sampling == "projected-solid-angle" || opt.light_sampling == "auto")
+    throw input_error("--light-sampling: '" + opt.light_sampling +
+                      "' is not available in this build (available: area, solid-angle)");
   if (!opt.light_sampling.empty())
     strategy = opt.light_sampling == "area" ? light_sampling::area : light_sampling::solid_angle;
 
@@ -192,7 +195,7 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--seed", ro.seed, "Random seed (default 0)");
   render_cmd->add_option("--threads", ro.threads, "Threads (default: all hardware threads)");
   render_cmd->add_option("--light-sampling", ro.light_sampling, "Sample every light by area or solid angle")
-      ->check(CLI::IsMember({"area", "solid-angle"}));
+      ->check(CLI::IsMember({"area", "solid-angle", "projected-solid-angle", "auto"}));
   render_cmd->add_option("--ellipse-map", ro.ellipse_map,
                          "Map of the spherical ellipse for ellipses sampled by solid angle (default parallel)")
       ->check(CLI::IsMember({"parallel", "polar"}));

@@ -236,11 +236,31 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
   const bool sampled = rd.boolean_or(o, path, "sample", false) || is_light;
 
   light_sampling strategy = light_sampling::area;
-  if (type.size() > 3 && type.ends_with("_sa")) {
+  const bool typed_sa = type.size() > 3 && type.ends_with("_sa");
+  if (typed_sa) {
     strategy = light_sampling::solid_angle;
     type.resize(type.size() - 3);
     if (type != "xz_rect" && type != "xy_rect" && type != "yz_rect" && type != "rect" && type != "ellipse")
       rd.ctx.fail(join(path, "type"), "unknown object type '" + type + "_sa'");
+  }
+  if (o.contains("sampling")) {
+    // The light's own strategy (the contract's per-light "sampling" field);
+    // --light-sampling, when given, still overrides it.
+    const std::string place = join(path, "sampling");
+    if (!sampled) rd.ctx.fail(place, "only a light or a sampled object (\"sample\": true) has a sampling strategy");
+    const std::string value = rd.string(o, path, "sampling");
+    light_sampling chosen;
+    if (value == "area")
+      chosen = light_sampling::area;
+    else if (value == "solid-angle")
+      chosen = light_sampling::solid_angle;
+    else if (value == "projected-solid-angle" || value == "auto")
+      rd.ctx.fail(place, "'" + value + "' is not available in this build (available: area, solid-angle)");
+    else
+      rd.ctx.fail(place, "unknown strategy '" + value + "' (expected area, solid-angle, projected-solid-angle or auto)");
+    if (typed_sa && chosen != light_sampling::solid_angle)
+      rd.ctx.fail(place, "'" + value + "' contradicts the type '" + type + "_sa' (sampled by solid angle)");
+    strategy = chosen;
   }
   if (override_strategy) strategy = *override_strategy;
 
@@ -255,7 +275,7 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
     const char a = type[0], b = type[1];
     const std::string a0 = std::string(1, a) + "0", a1 = std::string(1, a) + "1";
     const std::string b0 = std::string(1, b) + "0", b1 = std::string(1, b) + "1";
-    rd.only(o, path, {"type", "material", "flip", "sample", a0.c_str(), a1.c_str(), b0.c_str(), b1.c_str(), "k"});
+    rd.only(o, path, {"type", "material", "flip", "sample", "sampling", a0.c_str(), a1.c_str(), b0.c_str(), b1.c_str(), "k"});
     const auto [u0, u1] = interval(rd, o, path, a0.c_str(), a1.c_str());
     const auto [v0, v1] = interval(rd, o, path, b0.c_str(), b1.c_str());
     const float k = static_cast<float>(rd.number(o, path, "k"));
@@ -263,17 +283,17 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
         : type == "xy_rect" ? xy_rect(u0, u1, v0, v1, k, flip)
                             : yz_rect(u0, u1, v0, v1, k, flip));
   } else if (type == "rect") {
-    rd.only(o, path, {"type", "material", "flip", "sample", "corner", "edge1", "edge2"});
+    rd.only(o, path, {"type", "material", "flip", "sample", "sampling", "corner", "edge1", "edge2"});
     const vec3 c = rd.vector3(o, path, "corner"), e1 = rd.vector3(o, path, "edge1"), e2 = rd.vector3(o, path, "edge2");
     check_frame(rd, path, "edge1", "edge2", e1, e2);
     add(rect::make(c, e1, e2, flip));
   } else if (type == "ellipse") {
-    rd.only(o, path, {"type", "material", "flip", "sample", "center", "axis1", "axis2"});
+    rd.only(o, path, {"type", "material", "flip", "sample", "sampling", "center", "axis1", "axis2"});
     const vec3 c = rd.vector3(o, path, "center"), a1 = rd.vector3(o, path, "axis1"), a2 = rd.vector3(o, path, "axis2");
     check_frame(rd, path, "axis1", "axis2", a1, a2);
     add(ellipse::make(c, a1, a2, flip));
   } else if (type == "sphere") {
-    rd.only(o, path, {"type", "material", "flip", "sample", "center", "radius"});
+    rd.only(o, path, {"type", "material", "flip", "sample", "sampling", "center", "radius"});
     add(sphere{rd.vector3(o, path, "center"), positive(rd, o, path, "radius"), flip});
   } else if (type == "box") {
     rd.only(o, path, {"type", "material", "flip", "sample", "min", "max", "rotate_y", "translate"});
