@@ -120,8 +120,8 @@ TEST(LightSelection, ChoosesWithTheStatedProbabilities) {
     double total = 0.0;
     for (std::size_t k = 0; k < 5; ++k) total += sel.probability(k);
     EXPECT_NEAR(total, 1.0, 1e-6);
-    if (how == light_choice::power) EXPECT_NEAR(sel.probability(4), 5.0 / (1 + 2 + 4 + 5), 1e-6);
-    if (how == light_choice::uniform) EXPECT_NEAR(sel.probability(4), 0.25, 1e-6);
+    const double expected_p4 = how == light_choice::power ? 5.0 / (1 + 2 + 4 + 5) : 0.25;
+    EXPECT_NEAR(sel.probability(4), expected_p4, 1e-6);
     std::map<std::ptrdiff_t, int> counts;
     pcg32 rng(7, 7);
     const int n = 200000;

@@ -12,7 +12,13 @@
 // below 3e-4 for the 180 checks of this file), and additionally within 1 %
 // of the exact value, so a large standard error cannot hide a bias.
 // Replicates, not the spread of single samples, give the standard error:
-// the samples of one stratified or Sobol pixel are not independent.
+// the samples of one stratified or Sobol pixel are not independent. Where
+// the estimator has almost no variance (the polar map of a disk seen on its
+// axis under next-event estimation and Sobol points: standard error 6e-9 of
+// the value), the statistical bound is floored at 1e-6 of the exact value:
+// each sample is computed in single precision through a chain of some twenty
+// rounded operations (2^-24 = 6e-8 each), whose systematic part the
+// estimate cannot average away.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -76,7 +82,7 @@ estimate floor_radiance(const scene& sc, integrator_kind ik, sampler_kind sk, fl
 }
 
 void check(const estimate& e, double exact, const std::string& what) {
-  EXPECT_LE(std::abs(e.mean - exact), 6.0 * e.stderr_) << what << ": mean " << e.mean << " exact " << exact
+  EXPECT_LE(std::abs(e.mean - exact), std::max(6.0 * e.stderr_, 1e-6 * exact)) << what << ": mean " << e.mean << " exact " << exact
                                                         << " stderr " << e.stderr_;
   EXPECT_LE(std::abs(e.mean - exact), 0.01 * exact) << what << ": mean " << e.mean << " exact " << exact;
 }

@@ -7,6 +7,8 @@
 #include <string_view>
 
 #include "mcrt/samplers/independent.hpp"
+#include "mcrt/samplers/sobol_sampler.hpp"
+#include "mcrt/samplers/stratified.hpp"
 
 namespace mcrt {
 
@@ -16,6 +18,8 @@ enum class sampler_kind { independent, stratified, sobol };
 template <class F>
 decltype(auto) with_sampler(sampler_kind k, F&& f) {
   switch (k) {
+    case sampler_kind::stratified: return f.template operator()<stratified_sampler>();
+    case sampler_kind::sobol: return f.template operator()<sobol_sampler>();
     default: return f.template operator()<independent_sampler>();
   }
 }

@@ -28,17 +28,17 @@ namespace mcrt {
 
 // Coordinate dim (0 <= dim < sobol_dimensions) of the Sobol point of index
 // `index`, in 32-bit fixed point.
-constexpr std::uint32_t sobol_sample(std::uint32_t index, int dim) {
+inline std::uint32_t sobol_sample(std::uint32_t index, int dim) {
   if (dim == 0) return reverse_bits(index);
-  const std::array<std::uint32_t, sobol_bits>& v = sobol_matrices[static_cast<std::size_t>(dim)];
+  const std::array<std::uint32_t, sobol_bits>& v = sobol_matrices()[static_cast<std::size_t>(dim)];
   std::uint32_t x = 0;
-  for (int k = 0; index != 0; index >>= 1, ++k)
-    if (index & 1u) x ^= v[static_cast<std::size_t>(k)];
+  for (int k = 0; index != 0; index >>= 1, ++k)  // branch-free: the bits of an index are not predictable
+    x ^= v[static_cast<std::size_t>(k)] & (0u - (index & 1u));
   return x;
 }
 
 // The same as a float in [0, 1) (its top 24 bits).
-constexpr float sobol_sample_float(std::uint32_t index, int dim) { return unit_float(sobol_sample(index, dim)); }
+inline float sobol_sample_float(std::uint32_t index, int dim) { return unit_float(sobol_sample(index, dim)); }
 
 namespace sobol_detail {
 
@@ -48,7 +48,7 @@ namespace sobol_detail {
 using byte_tables = std::array<std::array<std::uint32_t, 256>, 4>;
 constexpr byte_tables make_dim1_reversed_tables() {
   byte_tables t{};
-  const auto& v = sobol_matrices[1];
+  const std::array<std::uint32_t, sobol_bits> v = sobol_direction_numbers(1);
   for (int b = 0; b < 4; ++b)
     for (int byte = 0; byte < 256; ++byte) {
       std::uint32_t x = 0;
