@@ -8,6 +8,7 @@
 #include <string>
 
 #include "image_io.hpp"
+#include "render_instances.hpp"
 #include "mcrt/mcrt.hpp"
 #include "scene_loader.hpp"
 
@@ -103,7 +104,7 @@ int run_render(const render_options& opt) {
   rs.heuristic = opt.mis_heuristic == "balance" ? mis_heuristic::balance : mis_heuristic::power;
   rs.choose = opt.light_select == "uniform" ? light_choice::uniform : light_choice::power;
 
-  const render_result res = render(ls.world, cam, rs, opt.quiet ? progress_callback{} : progress_callback(print_progress));
+  const render_result res = render_scene(ls.world, cam, rs, opt.quiet ? progress_callback{} : progress_callback(print_progress));
   const double samples = static_cast<double>(rs.width) * rs.height * rs.spp;
   const std::string strategy_used = strategy ? strategy_name(*strategy) : strategy_summary(ls.world);
   if (res.nonfinite_samples && !opt.quiet)
