@@ -61,14 +61,14 @@ TEST(MisWeights, SumToOneForRandomConfigurations) {
     const vec3 o{2.0f * rng.uniform() - 1.0f, 0.0f, 2.0f * rng.uniform() - 1.0f};
     const vec3 n = glm::normalize(vec3{rng.uniform() - 0.5f, 1.0f, rng.uniform() - 0.5f});
     const light_choice how = rng.uniform() < 0.5f ? light_choice::power : light_choice::uniform;
-    const light_selection sel(lights, emitters, o, how);
+    const light_selection sel(lights, emitters, o, n, how);
     if (sel.empty()) continue;
     float prob = 0.0f;
     const std::ptrdiff_t k = sel.pick(rng.uniform(), prob);
     ASSERT_GE(k, 0);
     EXPECT_FLOAT_EQ(prob, sel.probability(static_cast<std::size_t>(k)));
     light_sample s;
-    if (!sample(lights[static_cast<std::size_t>(k)], o, rng.uniform2(), s)) continue;
+    if (!sample(lights[static_cast<std::size_t>(k)], o, n, rng.uniform2(), s)) continue;
     const float cos_theta = glm::dot(s.dir, n);
     if (!(cos_theta > 0.0f)) continue;
     const float p_material = cos_theta * inv_pi;
@@ -113,9 +113,9 @@ TEST(LightSelection, ChoosesWithTheStatedProbabilities) {
     lights.push_back(rect_area_sampler{r});
     emitters.push_back({static_cast<std::uint32_t>(i), 1.0f + static_cast<float>(i)});
   }
-  const vec3 o{0.0f, 0.0f, 0.0f};
+  const vec3 o{0.0f, 0.0f, 0.0f}, n{0.0f, 1.0f, 0.0f};
   for (const light_choice how : {light_choice::power, light_choice::uniform}) {
-    const light_selection sel(lights, emitters, o, how);
+    const light_selection sel(lights, emitters, o, n, how);
     EXPECT_EQ(sel.probability(2), 0.0f) << "a light seen from behind is never chosen";
     double total = 0.0;
     for (std::size_t k = 0; k < 5; ++k) total += sel.probability(k);

@@ -2,6 +2,7 @@
 // The lights of a scene: every shape that is sampled directly, each with its
 // sampling strategy, in one std::variant so a scene holds exactly the
 // strategies it uses and dispatch is a few compares, not a virtual call.
+#include <concepts>
 #include <variant>
 
 #include "mcrt/core/dispatch.hpp"
@@ -17,23 +18,46 @@ namespace mcrt {
 using light = std::variant<rect_area_sampler, rect_solid_angle_sampler, ellipse_area_sampler,
                            ellipse_solid_angle_sampler, ellipse_polar_solid_angle_sampler, sphere_cone_sampler>;
 
-// The free functions light_pdf (render/pdf.hpp) calls: the strategy's own
-// members for a plain strategy, a static dispatch for the variant.
+// The free functions light_pdf (render/pdf.hpp) and the integrators call:
+// the strategy's own members for a plain strategy, a static dispatch for the
+// variant. The receiving surface's unit normal n reaches the strategies that
+// use it (cosine-aware ones, with members sample(o, n, u, s) and
+// pdf(o, n, dir)); the others (area, solid angle) are called without it.
+template <class S>
+concept normal_aware_strategy = requires(const S& s, const vec3& v, vec2 u, light_sample& out) {
+  { s.sample(v, v, u, out) } -> std::convertible_to<bool>;
+  { s.pdf(v, v, v) } -> std::convertible_to<float>;
+};
+
 template <class S>
 bool faces(const S& s, const vec3& o) { return s.faces(o); }
 template <class S>
 bool sample(const S& s, const vec3& o, vec2 u, light_sample& out) { return s.sample(o, u, out); }
 template <class S>
 float pdf(const S& s, const vec3& o, const vec3& dir) { return s.pdf(o, dir); }
+template <class S>
+bool sample(const S& s, const vec3& o, const vec3& n, vec2 u, light_sample& out) {
+  if constexpr (normal_aware_strategy<S>)
+    return s.sample(o, n, u, out);
+  else
+    return s.sample(o, u, out);
+}
+template <class S>
+float pdf(const S& s, const vec3& o, const vec3& n, const vec3& dir) {
+  if constexpr (normal_aware_strategy<S>)
+    return s.pdf(o, n, dir);
+  else
+    return s.pdf(o, dir);
+}
 
 inline bool faces(const light& l, const vec3& o) {
   return dispatch(l, [&](const auto& s) { return s.faces(o); });
 }
-inline bool sample(const light& l, const vec3& o, vec2 u, light_sample& out) {
-  return dispatch(l, [&](const auto& s) { return s.sample(o, u, out); });
+inline bool sample(const light& l, const vec3& o, const vec3& n, vec2 u, light_sample& out) {
+  return dispatch(l, [&](const auto& s) { return mcrt::sample(s, o, n, u, out); });
 }
-inline float pdf(const light& l, const vec3& o, const vec3& dir) {
-  return dispatch(l, [&](const auto& s) { return s.pdf(o, dir); });
+inline float pdf(const light& l, const vec3& o, const vec3& n, const vec3& dir) {
+  return dispatch(l, [&](const auto& s) { return mcrt::pdf(s, o, n, dir); });
 }
 
 // Surface area of a light's shape (the whole sphere for a sphere).

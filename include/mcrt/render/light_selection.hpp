@@ -31,8 +31,11 @@ enum class light_choice { power, uniform };
 
 class light_selection {
  public:
-  light_selection(std::span<const light> lights, std::span<const emitter> emitters, const vec3& o, light_choice how)
-      : lights_(lights), emitters_(emitters), o_(o), uniform_(how == light_choice::uniform) {
+  // o: the shading point; n: the unit normal of its surface (for the
+  // cosine-aware strategies' densities).
+  light_selection(std::span<const light> lights, std::span<const emitter> emitters, const vec3& o, const vec3& n,
+                  light_choice how)
+      : lights_(lights), emitters_(emitters), o_(o), n_(n), uniform_(how == light_choice::uniform) {
     for (const emitter& e : emitters_)
       if (faces(lights_[e.light], o_)) {
         ++count_;
@@ -44,11 +47,15 @@ class light_selection {
   }
 
   template <class Scene>
-  light_selection(const Scene& sc, const vec3& o, light_choice how) : light_selection(sc.lights, sc.emitters, o, how) {}
+  light_selection(const Scene& sc, const vec3& o, const vec3& n, light_choice how)
+      : light_selection(sc.lights, sc.emitters, o, n, how) {}
 
   bool empty() const { return count_ == 0; }
   // Whether the choice needs a random number (more than one candidate).
   bool needs_choice() const { return emitters_.size() > 1; }
+
+  const vec3& point() const { return o_; }
+  const vec3& normal() const { return n_; }
 
   // Picks a facing emitter with u in [0, 1): its index in the scene's
   // lights, or -1 when there is none; prob is P(k).
@@ -100,7 +107,7 @@ class light_selection {
     for (const emitter& e : emitters_) {
       const float p = probability_of(e);
       if (!(p > 0.0f)) continue;
-      sum += p * (static_cast<std::ptrdiff_t>(e.light) == known ? known_pdf : mcrt::pdf(lights_[e.light], o_, dir));
+      sum += p * (static_cast<std::ptrdiff_t>(e.light) == known ? known_pdf : mcrt::pdf(lights_[e.light], o_, n_, dir));
     }
     return sum;
   }
@@ -113,7 +120,7 @@ class light_selection {
 
   std::span<const light> lights_;
   std::span<const emitter> emitters_;
-  vec3 o_;
+  vec3 o_, n_;
   bool uniform_;
   std::size_t count_ = 0;
   float total_ = 0.0f;

@@ -41,7 +41,7 @@ struct mixture_integrator {
       if (const auto* lam = std::get_if<lambertian>(&m)) {
         const vec3 n = rec.facing_normal();
         const cosine_pdf cos_pdf(n);
-        const light_pdf<light> lights(sc.lights, rec.p);
+        const light_pdf<light> lights(sc.lights, rec.p, n);
         const mixture_pdf<light> mix(cos_pdf, lights);
         const float u_select = ps.get1d(b + layout::light_choice);
         const bool from_cosine = lights.empty() || u_select < 0.5f;

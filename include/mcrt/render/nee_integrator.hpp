@@ -49,7 +49,7 @@ color sample_direct_light(const Scene& sc, const vec3& p, const vec3& n, const c
   const std::ptrdiff_t k = sel.pick(sel.needs_choice() ? ps.get1d(b + layout::light_choice) : 0.0f, prob);
   if (k < 0) return color(0.0f);
   light_sample s;
-  if (!sample(sc.lights[static_cast<std::size_t>(k)], p, ps.get2d(b + layout::light), s)) return color(0.0f);
+  if (!sample(sc.lights[static_cast<std::size_t>(k)], p, n, ps.get2d(b + layout::light), s)) return color(0.0f);
   const float cos_theta = glm::dot(s.dir, n);
   if (!(cos_theta > 0.0f)) return color(0.0f);
   const float p_light = sel.pdf(s.dir, k, s.pdf);
@@ -71,7 +71,7 @@ struct next_event_integrator {
     // density of the direction the material sampled, for the weight of the
     // emission the direction meets.
     bool after_diffuse = false;
-    light_selection prev_sel(sc, vec3(0.0f), set.choose);
+    light_selection prev_sel(sc, vec3(0.0f), vec3(0.0f, 0.0f, 1.0f), set.choose);
     float prev_p_material = 0.0f;
     for (int depth = 0;; ++depth) {
       hit_record rec;
@@ -92,7 +92,7 @@ struct next_event_integrator {
 
       if (const auto* lam = std::get_if<lambertian>(&m)) {
         const vec3 n = rec.facing_normal();
-        const light_selection sel(sc, rec.p, set.choose);
+        const light_selection sel(sc, rec.p, n, set.choose);
         radiance += throughput * sample_direct_light<Weights>(sc, rec.p, n, lam->albedo, sel, ps, b, set);
         if (depth >= set.rr_depth && !survive_roulette(throughput, [&] { return ps.get1d(b + layout::roulette); }))
           break;

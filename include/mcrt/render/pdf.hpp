@@ -34,7 +34,9 @@ class cosine_pdf {
 template <class Light>
 class light_pdf {
  public:
-  light_pdf(std::span<const Light> lights, const vec3& o) : lights_(lights), o_(o) {
+  // o: the point; n: the unit normal of its surface, for the strategies
+  // that weigh by the cosine there.
+  light_pdf(std::span<const Light> lights, const vec3& o, const vec3& n) : lights_(lights), o_(o), n_(n) {
     for (const Light& l : lights_) count_ += faces(l, o_) ? 1 : 0;
   }
 
@@ -46,7 +48,7 @@ class light_pdf {
     std::size_t k = std::min(static_cast<std::size_t>(u_pick * static_cast<float>(count_)), count_ - 1);
     for (std::size_t i = 0; i < lights_.size(); ++i) {
       if (!faces(lights_[i], o_)) continue;
-      if (k-- == 0) return sample(lights_[i], o_, u, s) ? static_cast<std::ptrdiff_t>(i) : -1;
+      if (k-- == 0) return sample(lights_[i], o_, n_, u, s) ? static_cast<std::ptrdiff_t>(i) : -1;
     }
     return -1;
   }
@@ -60,13 +62,13 @@ class light_pdf {
     if (count_ == 0) return 0.0f;
     float sum = 0.0f;
     for (std::size_t i = 0; i < lights_.size(); ++i)
-      sum += static_cast<std::ptrdiff_t>(i) == known ? known_pdf : pdf(lights_[i], o_, dir);
+      sum += static_cast<std::ptrdiff_t>(i) == known ? known_pdf : pdf(lights_[i], o_, n_, dir);
     return sum / static_cast<float>(count_);
   }
 
  private:
   std::span<const Light> lights_;
-  vec3 o_;
+  vec3 o_, n_;
   std::size_t count_ = 0;
 };
 

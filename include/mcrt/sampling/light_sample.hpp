@@ -12,6 +12,17 @@
 //           would return false.
 //   bool  faces(const vec3& o) const;
 //           whether sample() can return a direction for o at all.
+//
+// A cosine-aware strategy (one that samples by projected solid angle, or
+// weighs by the cosine at the receiver) takes the receiving surface's unit
+// normal n as well:
+//   bool  sample(const vec3& o, const vec3& n, vec2 u, light_sample& s) const;
+//   float pdf(const vec3& o, const vec3& n, const vec3& dir) const;
+// with the same meaning (pdf still per unit SOLID ANGLE), false / 0 also
+// where the light lies wholly below the horizon of n. The renderer calls
+// every strategy through the free functions sample(l, o, n, u, s) and
+// pdf(l, o, n, dir) of render/light.hpp, which drop n for the strategies
+// that ignore it (area, solid angle).
 #include "mcrt/core/math.hpp"
 
 namespace mcrt {
