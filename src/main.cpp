@@ -1,4 +1,4 @@
-// The mcrt executable: `mcrt render` and `mcrt diff` (shared/spec cli.md).
+// The mcrt executable: `mcrt render`, `mcrt diff` and `mcrt samples` (shared/spec cli.md).
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -9,6 +9,7 @@
 
 #include "image_io.hpp"
 #include "render_instances.hpp"
+#include "samples_command.hpp"
 #include "mcrt/mcrt.hpp"
 #include "scene_loader.hpp"
 
@@ -72,12 +73,7 @@ int run_render(const render_options& opt) {
   check_range(opt.max_depth, "--max-depth", 0, max_depth_limit);
   check_range(opt.rr_depth, "--rr-depth", 0, max_depth_limit);
   if (opt.threads && *opt.threads == 0) throw input_error("--threads: must be >= 1");
-  std::optional<light_sampling> strategy;
-  if (opt.light_sampling == "projected-solid-angle" || opt.light_sampling == "auto")
-    throw input_error("--light-sampling: '" + opt.light_sampling +
-                      "' is not available in this build (available: area, solid-angle)");
-  if (!opt.light_sampling.empty())
-    strategy = opt.light_sampling == "area" ? light_sampling::area : light_sampling::solid_angle;
+  const std::optional<light_sampling> strategy = parse_light_sampling_flag(opt.light_sampling);
 
   const cli::ellipse_map map = opt.ellipse_map == "polar" ? cli::ellipse_map::polar : cli::ellipse_map::parallel;
   loaded_scene ls = load_scene(opt.scene, strategy, map);
@@ -220,8 +216,23 @@ int main(int argc, char** argv) {
   diff_cmd->add_option("reference", dop.reference, "Reference image")->required();
   diff_cmd->add_flag("--json", dop.json, "Print one JSON object");
 
-  if (argc > 1 && argv[1][0] != '-' && std::string(argv[1]) != "render" && std::string(argv[1]) != "diff") {
-    std::fprintf(stderr, "mcrt: unknown command '%s' (expected render or diff; see mcrt --help)\n", argv[1]);
+  samples_options sop;
+  CLI::App* samples_cmd = app.add_subcommand("samples", "Write samples of one light's strategy as CSV");
+  samples_cmd->add_option("scene", sop.scene, "Scene file (JSON)")->required();
+  samples_cmd->add_option("--light", sop.light, "Index of the light among the scene's lights, in file order")->required();
+  samples_cmd->add_option("--from", sop.from, "The receiving point X,Y,Z")->required();
+  samples_cmd->add_option("--normal", sop.normal, "The receiving surface's normal X,Y,Z")->required();
+  samples_cmd->add_option("--light-sampling", sop.light_sampling, "Strategy (default: the light's own)")
+      ->check(CLI::IsMember({"area", "solid-angle", "projected-solid-angle", "auto"}));
+  samples_cmd->add_option("--ellipse-map", sop.ellipse_map, "Map of the spherical ellipse (default parallel)")
+      ->check(CLI::IsMember({"parallel", "polar"}));
+  samples_cmd->add_option("--n", sop.n, "Number of samples (default 100000)");
+  samples_cmd->add_option("--seed", sop.seed, "Random seed (default 0)");
+  samples_cmd->add_option("-o,--output", sop.output, "CSV file (default: standard output)");
+
+  if (argc > 1 && argv[1][0] != '-' && std::string(argv[1]) != "render" && std::string(argv[1]) != "diff" &&
+      std::string(argv[1]) != "samples") {
+    std::fprintf(stderr, "mcrt: unknown command '%s' (expected render, diff or samples; see mcrt --help)\n", argv[1]);
     return 2;
   }
   try {
@@ -237,7 +248,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    return render_cmd->parsed() ? run_render(ro) : run_diff(dop);
+    if (render_cmd->parsed()) return run_render(ro);
+    if (samples_cmd->parsed()) return run_samples(sop);
+    return run_diff(dop);
   } catch (const input_error& e) {
     std::fprintf(stderr, "mcrt: %s\n", e.what());
     return 2;

@@ -313,6 +313,16 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
 
 }  // namespace
 
+std::optional<light_sampling> parse_light_sampling_flag(const std::string& value) {
+  if (value.empty()) return std::nullopt;
+  if (value == "area") return light_sampling::area;
+  if (value == "solid-angle") return light_sampling::solid_angle;
+  if (value == "projected-solid-angle" || value == "auto")
+    throw input_error("--light-sampling: '" + value + "' is not available in this build (available: area, solid-angle)");
+  throw input_error("--light-sampling: unknown strategy '" + value +
+                    "' (expected area, solid-angle, projected-solid-angle or auto)");
+}
+
 loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy, ellipse_map map) {
   const context ctx{path};
   const reader rd{ctx};

@@ -38,6 +38,10 @@ struct loaded_scene {
 // polar one.
 enum class ellipse_map { parallel, polar };
 
+// The strategy a --light-sampling value names; nullopt for "" (no flag).
+// Throws input_error for the strategies this build does not have.
+std::optional<light_sampling> parse_light_sampling_flag(const std::string& value);
+
 // override_strategy: --light-sampling; switches every light to one strategy.
 // map: --ellipse-map; the map of every ellipse sampled by solid angle.
 loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy = std::nullopt,

@@ -312,6 +312,60 @@ TEST_F(Cli, PerLightSamplingField) {
   expect_bad("render " + s.string() + " -o " + out2.string() + " --quiet --light-sampling auto", {"--light-sampling", "not available"}, out2);
 }
 
+// mcrt samples: the CSV of the contract, to a file or to stdout; samples on
+// the light with their pdf, rows of pdf 0 where the light faces away; bad
+// arguments refused with one line and exit 2, the output untouched.
+TEST_F(Cli, SamplesWritesTheContractsCsv) {
+  const fs::path scene = fs::path(MCRT_SCENES_DIR) / "cornell_rect.json", out = dir / "s.csv";
+  const std::string base = "samples " + scene.string() + " --light 0 --from 278,1,279 --normal 0,1,0 ";
+  for (const char* strategy : {"area", "solid-angle"}) {
+    ASSERT_EQ(run(base + "--n 2000 --seed 4 --light-sampling " + strategy + " -o " + out.string()).status, 0);
+    std::istringstream csv(slurp(out));
+    std::string line;
+    std::getline(csv, line);
+    EXPECT_EQ(line, "u1,u2,dx,dy,dz,px,py,pz,pdf");
+    int rows = 0;
+    double inv_pdf = 0.0;
+    while (std::getline(csv, line)) {
+      double v[9];
+      char c;
+      std::istringstream row(line);
+      row >> v[0];
+      for (int i = 1; i < 9; ++i) row >> c >> v[i];
+      ASSERT_TRUE(row) << line;
+      EXPECT_GE(v[0], 0.0);
+      EXPECT_LT(v[0], 1.0);
+      EXPECT_NEAR(v[2] * v[2] + v[3] * v[3] + v[4] * v[4], 1.0, 1e-5) << line;
+      EXPECT_NEAR(v[6], 554.0, 1e-2) << "the point must lie on the light: " << line;
+      EXPECT_TRUE(v[5] >= 213 - 1e-2 && v[5] <= 343 + 1e-2 && v[7] >= 227 - 1e-2 && v[7] <= 332 + 1e-2) << line;
+      EXPECT_GT(v[8], 0.0);
+      inv_pdf += 1.0 / v[8];
+      ++rows;
+    }
+    EXPECT_EQ(rows, 2000);
+    // E[1/pdf] is the light's solid angle from (278, 1, 279): 0.0441 sr (README's extremes table), to 3 %.
+    EXPECT_NEAR(inv_pdf / rows, 0.04413, 0.03 * 0.04413) << strategy;
+  }
+  // To stdout, and from above the light (it faces down): rows of pdf 0.
+  result r = run("samples " + scene.string() + " --light 0 --from 278,600,279 --normal 0,1,0 --n 3");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 4);
+  EXPECT_NE(r.out.find(",0,0,0,0,0,0,0\n"), std::string::npos) << r.out;
+  // The same seed gives the same samples.
+  EXPECT_EQ(run(base + "--n 50 --seed 9").out, run(base + "--n 50 --seed 9").out);
+  EXPECT_NE(run(base + "--n 50 --seed 9").out, run(base + "--n 50 --seed 10").out);
+
+  expect_bad(base + "--n 0 -o " + out.string(), {"--n"}, out);
+  expect_bad("samples " + scene.string() + " --light 1 --from 278,1,279 --normal 0,1,0 -o " + out.string(), {"--light", "1 light"}, out);
+  expect_bad("samples " + scene.string() + " --light 0 --from 278,1 --normal 0,1,0 -o " + out.string(), {"--from"}, out);
+  expect_bad("samples " + scene.string() + " --light 0 --from 278,1,279 --normal 0,0,0 -o " + out.string(), {"--normal"}, out);
+  expect_bad("samples " + scene.string() + " --light 0 --from 278,1,279 -o " + out.string(), {"--normal"}, out);
+  expect_bad(base + "--light-sampling sideways -o " + out.string(), {"--light-sampling"}, out);
+  expect_bad("samples " + (dir / "missing.json").string() + " --light 0 --from 1,1,1 --normal 0,1,0 -o " + out.string(),
+             {"missing.json"}, out);
+  expect_bad(base + "-o " + (dir / "no_such_dir" / "s.csv").string(), {"no_such_dir"}, out);
+}
+
 TEST_F(Cli, EveryShippedSceneRenders) {
   for (const auto& e : fs::directory_iterator(MCRT_SCENES_DIR)) {
     if (e.path().extension() != ".json") continue;

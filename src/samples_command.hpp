@@ -1,0 +1,19 @@
+#pragma once
+// `mcrt samples`: N independent samples of one light's strategy, as seen from
+// a point with a normal, written as CSV (shared/spec cli.md).
+#include <cstdint>
+#include <string>
+
+namespace mcrt::cli {
+
+struct samples_options {
+  std::string scene, output, light_sampling, from, normal, ellipse_map = "parallel";
+  long long light = -1;
+  long long n = 100000;
+  std::uint64_t seed = 0;
+};
+
+// Throws input_error (exit status 2) for bad arguments, before writing anything.
+int run_samples(const samples_options& opt);
+
+}  // namespace mcrt::cli
