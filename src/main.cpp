@@ -20,7 +20,7 @@ using namespace mcrt::cli;
 
 struct render_options {
   std::string scene, output, stats, light_sampling, ellipse_map = "parallel";
-  std::string integrator = "mixture", sampler = "independent", mis_heuristic = "power", light_select = "power";
+  std::string integrator = "mixture", sampler = "sobol", mis_heuristic = "power", light_select = "power";
   std::optional<int> spp, width, height, max_depth, rr_depth;
   std::optional<unsigned> threads;
   std::uint64_t seed = 0;
@@ -38,25 +38,18 @@ void check_range(const std::optional<int>& v, const char* flag, int lo, int hi) 
                       "], got " + std::to_string(*v));
 }
 
-std::string strategy_name(light_sampling s) { return s == light_sampling::area ? "area" : "solid-angle"; }
-
-// What the lights of a scene use, for --stats: "area", "solid-angle",
-// "mixed" or "none".
+// What the lights of a scene use, for --stats: one strategy's name (see
+// light_sampling), "mixed" or "none". Only emitters count: book 3's glass
+// sphere ("sample": true, emits nothing) is an importance target of the
+// mixture, not a light.
 std::string strategy_summary(const scene& world) {
-  bool area = false, sa = false;
-  for (const light& l : world.lights) {
-    std::visit(
-        [&](const auto& s) {
-          using S = std::decay_t<decltype(s)>;
-          if constexpr (std::is_same_v<S, rect_area_sampler> || std::is_same_v<S, ellipse_area_sampler>)
-            area = true;
-          else if constexpr (std::is_same_v<S, rect_solid_angle_sampler> || std::is_same_v<S, ellipse_solid_angle_sampler> ||
-                             std::is_same_v<S, ellipse_polar_solid_angle_sampler>)
-            sa = true;  // spheres have one strategy only and do not count
-        },
-        l);
+  std::optional<light_sampling> first;
+  for (const emitter& e : world.emitters) {
+    const light_sampling s = strategy_of(world.lights[e.light]);
+    if (first && *first != s) return "mixed";
+    first = s;
   }
-  return area && sa ? "mixed" : area ? "area" : sa ? "solid-angle" : "none";
+  return first ? std::string(to_string(*first)) : "none";
 }
 
 void print_progress(double fraction, double elapsed) {
@@ -102,7 +95,7 @@ int run_render(const render_options& opt) {
 
   const render_result res = render_scene(ls.world, cam, rs, opt.quiet ? progress_callback{} : progress_callback(print_progress));
   const double samples = static_cast<double>(rs.width) * rs.height * rs.spp;
-  const std::string strategy_used = strategy ? strategy_name(*strategy) : strategy_summary(ls.world);
+  const std::string strategy_used = strategy_summary(ls.world);
   if (res.nonfinite_samples && !opt.quiet)
     std::fprintf(stderr, "mcrt: %llu non-finite radiance samples were dropped\n",
                  static_cast<unsigned long long>(res.nonfinite_samples));
@@ -191,8 +184,9 @@ int main(int argc, char** argv) {
                          "Scattering events before Russian roulette starts (default 1; >= max depth: off)");
   render_cmd->add_option("--seed", ro.seed, "Random seed (default 0)");
   render_cmd->add_option("--threads", ro.threads, "Threads (default: all hardware threads)");
-  render_cmd->add_option("--light-sampling", ro.light_sampling, "Sample every light by area or solid angle")
-      ->check(CLI::IsMember({"area", "solid-angle", "projected-solid-angle", "auto"}));
+  render_cmd->add_option("--light-sampling", ro.light_sampling, "Sample every light by area, solid-angle, projected-solid-angle (cosine-aware) or "
+                         "bilinear-solid-angle (comparison: bilinear cosine pre-warp)")
+      ->check(CLI::IsMember({"area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle", "auto"}));
   render_cmd->add_option("--ellipse-map", ro.ellipse_map,
                          "Map of the spherical ellipse for ellipses sampled by solid angle (default parallel)")
       ->check(CLI::IsMember({"parallel", "polar"}));
@@ -200,7 +194,7 @@ int main(int argc, char** argv) {
                          "Estimator: mixture (Shirley's mixture pdf, default), nee (next-event estimation) or mis "
                          "(next-event estimation with multiple importance sampling)")
       ->check(CLI::IsMember({"mixture", "nee", "mis"}));
-  render_cmd->add_option("--sampler", ro.sampler, "Sample generator: independent, stratified or sobol")
+  render_cmd->add_option("--sampler", ro.sampler, "Sample generator: independent, stratified or sobol (default: sobol)")
       ->check(CLI::IsMember({"independent", "stratified", "sobol"}));
   render_cmd->add_option("--mis-heuristic", ro.mis_heuristic, "Weights of --integrator mis: power (beta = 2, default) or balance")
       ->check(CLI::IsMember({"power", "balance"}));
@@ -223,7 +217,7 @@ int main(int argc, char** argv) {
   samples_cmd->add_option("--from", sop.from, "The receiving point X,Y,Z")->required();
   samples_cmd->add_option("--normal", sop.normal, "The receiving surface's normal X,Y,Z")->required();
   samples_cmd->add_option("--light-sampling", sop.light_sampling, "Strategy (default: the light's own)")
-      ->check(CLI::IsMember({"area", "solid-angle", "projected-solid-angle", "auto"}));
+      ->check(CLI::IsMember({"area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle", "auto"}));
   samples_cmd->add_option("--ellipse-map", sop.ellipse_map, "Map of the spherical ellipse (default parallel)")
       ->check(CLI::IsMember({"parallel", "polar"}));
   samples_cmd->add_option("--n", sop.n, "Number of samples (default 100000)");

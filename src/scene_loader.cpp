@@ -202,25 +202,52 @@ std::pair<float, float> interval(const reader& rd, const json& o, const std::str
 
 // Adds a directly sampled shape (a light, or an importance target such as
 // book 3's glass sphere) with its strategy: the geometry and the light.
-void add_light(scene& world, const rect& s, std::uint32_t mat, light_sampling strategy, ellipse_map) {
-  if (strategy == light_sampling::area)
-    world.add_light(rect_area_sampler{s}, mat);
-  else
-    world.add_light(rect_solid_angle_sampler{s}, mat);
+// `strategy` is nullopt where neither the scene nor the command line names
+// one: rectangles and ellipses are then sampled by area, spheres by their
+// cone of directions (solid angle), as the seed's scenes were. A shape
+// without the named strategy keeps the closest one it has: a sphere asked
+// for bilinear-solid-angle (a pre-warp of a planar light's map) gets its
+// exact projected-solid-angle map, which that pre-warp approximates.
+void add_light(scene& world, const rect& s, std::uint32_t mat, std::optional<light_sampling> strategy, ellipse_map) {
+  switch (strategy.value_or(light_sampling::area)) {
+    case light_sampling::area: world.add_light(rect_area_sampler{s}, mat); return;
+    case light_sampling::solid_angle: world.add_light(rect_solid_angle_sampler{s}, mat); return;
+    case light_sampling::projected_solid_angle: world.add_light(rect_projected_solid_angle_sampler{s}, mat); return;
+    case light_sampling::bilinear_solid_angle: world.add_light(rect_bilinear_solid_angle_sampler{s}, mat); return;
+  }
 }
-void add_light(scene& world, const ellipse& s, std::uint32_t mat, light_sampling strategy, ellipse_map map) {
-  if (strategy == light_sampling::area)
-    world.add_light(ellipse_area_sampler{s}, mat);
-  else if (map == ellipse_map::polar)
-    world.add_light(ellipse_polar_solid_angle_sampler{s}, mat);
-  else
-    world.add_light(ellipse_solid_angle_sampler{s}, mat);
+void add_light(scene& world, const ellipse& s, std::uint32_t mat, std::optional<light_sampling> strategy,
+               ellipse_map map) {
+  switch (strategy.value_or(light_sampling::area)) {
+    case light_sampling::area: world.add_light(ellipse_area_sampler{s}, mat); return;
+    case light_sampling::solid_angle:
+      if (map == ellipse_map::polar)
+        world.add_light(ellipse_polar_solid_angle_sampler{s}, mat);
+      else
+        world.add_light(ellipse_solid_angle_sampler{s}, mat);
+      return;
+    case light_sampling::projected_solid_angle: world.add_light(ellipse_projected_solid_angle_sampler{s}, mat); return;
+    case light_sampling::bilinear_solid_angle: world.add_light(ellipse_bilinear_solid_angle_sampler{s}, mat); return;
+  }
 }
-// A sphere is sampled by its cone of directions (uniform in solid angle)
-// under either strategy: there is no area strategy for spheres.
-void add_light(scene& world, const sphere& s, std::uint32_t mat, light_sampling, ellipse_map) {
-  world.add_light(sphere_cone_sampler{s}, mat);
+void add_light(scene& world, const sphere& s, std::uint32_t mat, std::optional<light_sampling> strategy, ellipse_map) {
+  switch (strategy.value_or(light_sampling::solid_angle)) {
+    case light_sampling::area: world.add_light(sphere_area_sampler{s}, mat); return;
+    case light_sampling::solid_angle: world.add_light(sphere_cone_sampler{s}, mat); return;
+    case light_sampling::projected_solid_angle:
+    case light_sampling::bilinear_solid_angle: world.add_light(sphere_projected_solid_angle_sampler{s}, mat); return;
+  }
 }
+
+// A strategy's name in a scene file or on the command line; nullopt for a
+// name that is not a strategy ("auto" included: see parse_light_sampling_flag).
+std::optional<light_sampling> strategy_named(const std::string& value) {
+  for (const light_sampling s : {light_sampling::area, light_sampling::solid_angle, light_sampling::projected_solid_angle,
+                                 light_sampling::bilinear_solid_angle})
+    if (value == to_string(s)) return s;
+  return std::nullopt;
+}
+constexpr const char* strategy_names = "area, solid-angle, projected-solid-angle, bilinear-solid-angle or auto";
 
 void read_object(const reader& rd, const json& o, const std::string& path, scene& world,
                  const std::map<std::string, std::uint32_t>& material_ids,
@@ -235,7 +262,7 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
   const bool is_light = std::holds_alternative<diffuse_light>(world.materials[mat]);
   const bool sampled = rd.boolean_or(o, path, "sample", false) || is_light;
 
-  light_sampling strategy = light_sampling::area;
+  std::optional<light_sampling> strategy;  // nullopt: the shape's default (see add_light)
   const bool typed_sa = type.size() > 3 && type.ends_with("_sa");
   if (typed_sa) {
     strategy = light_sampling::solid_angle;
@@ -249,20 +276,19 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
     const std::string place = join(path, "sampling");
     if (!sampled) rd.ctx.fail(place, "only a light or a sampled object (\"sample\": true) has a sampling strategy");
     const std::string value = rd.string(o, path, "sampling");
-    light_sampling chosen;
-    if (value == "area")
-      chosen = light_sampling::area;
-    else if (value == "solid-angle")
-      chosen = light_sampling::solid_angle;
-    else if (value == "projected-solid-angle" || value == "auto")
-      rd.ctx.fail(place, "'" + value + "' is not available in this build (available: area, solid-angle)");
-    else
-      rd.ctx.fail(place, "unknown strategy '" + value + "' (expected area, solid-angle, projected-solid-angle or auto)");
-    if (typed_sa && chosen != light_sampling::solid_angle)
+    const std::optional<light_sampling> chosen = strategy_named(value);
+    if (value == "auto")
+      rd.ctx.fail(place, "'auto' is not available in this build (available: area, solid-angle, projected-solid-angle, "
+                         "bilinear-solid-angle)");
+    if (!chosen) rd.ctx.fail(place, "unknown strategy '" + value + "' (expected " + strategy_names + ")");
+    if (typed_sa && *chosen != light_sampling::solid_angle)
       rd.ctx.fail(place, "'" + value + "' contradicts the type '" + type + "_sa' (sampled by solid angle)");
     strategy = chosen;
   }
-  if (override_strategy) strategy = *override_strategy;
+  // --light-sampling switches the lights (the contract: "every light of the
+  // scene"); an importance target that emits nothing (book 3's glass sphere)
+  // keeps its own strategy.
+  if (override_strategy && is_light) strategy = *override_strategy;
 
   auto add = [&](const auto& shape) {
     if (sampled)
@@ -315,12 +341,11 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
 
 std::optional<light_sampling> parse_light_sampling_flag(const std::string& value) {
   if (value.empty()) return std::nullopt;
-  if (value == "area") return light_sampling::area;
-  if (value == "solid-angle") return light_sampling::solid_angle;
-  if (value == "projected-solid-angle" || value == "auto")
-    throw input_error("--light-sampling: '" + value + "' is not available in this build (available: area, solid-angle)");
-  throw input_error("--light-sampling: unknown strategy '" + value +
-                    "' (expected area, solid-angle, projected-solid-angle or auto)");
+  if (const auto s = strategy_named(value)) return s;
+  if (value == "auto")
+    throw input_error("--light-sampling: 'auto' is not available in this build (available: area, solid-angle, "
+                      "projected-solid-angle, bilinear-solid-angle)");
+  throw input_error("--light-sampling: unknown strategy '" + value + "' (expected " + strategy_names + ")");
 }
 
 loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy, ellipse_map map) {

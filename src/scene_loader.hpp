@@ -42,7 +42,8 @@ enum class ellipse_map { parallel, polar };
 // Throws input_error for the strategies this build does not have.
 std::optional<light_sampling> parse_light_sampling_flag(const std::string& value);
 
-// override_strategy: --light-sampling; switches every light to one strategy.
+// override_strategy: --light-sampling; switches every light (emitter) to one
+// strategy; non-emitting sampled objects keep their own.
 // map: --ellipse-map; the map of every ellipse sampled by solid angle.
 loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy = std::nullopt,
                         ellipse_map map = ellipse_map::parallel);

@@ -302,7 +302,21 @@ TEST_F(Cli, PerLightSamplingField) {
   ASSERT_EQ(run("render " + s.string() + " -o " + out.string() + " --light-sampling area --stats " + stats.string() + " --quiet").status, 0);
   EXPECT_EQ(nlohmann::json::parse(slurp(stats))["light_sampling"], "area");
   expect_bad_scene(scene_with(floor + ", " + lamp + R"(, "sampling": "sideways"})"), {"objects[1].sampling", "sideways"});
-  expect_bad_scene(scene_with(floor + ", " + lamp + R"(, "sampling": "projected-solid-angle"})"),
+  for (const char* strategy : {"projected-solid-angle", "bilinear-solid-angle"}) {
+    const fs::path c = write("lamp_c.json", scene_with(floor + ", " + lamp + R"(, "sampling": ")" + strategy + R"("})"));
+    ASSERT_EQ(run("render " + c.string() + " -o " + out.string() + " --stats " + stats.string() + " --quiet").status, 0) << strategy;
+    EXPECT_EQ(nlohmann::json::parse(slurp(stats))["light_sampling"], strategy);
+  }
+  // A sphere light without the field keeps its cone (solid angle); with it, its own strategy.
+  const std::string ball = R"({"type": "sphere", "center": [0, 2, 0], "radius": 0.5, "material": "light")";
+  for (const auto& [field, used] : {std::pair{"", "solid-angle"}, {R"(, "sampling": "area")", "area"},
+                                    {R"(, "sampling": "projected-solid-angle")", "projected-solid-angle"},
+                                    {R"(, "sampling": "bilinear-solid-angle")", "projected-solid-angle"}}) {
+    const fs::path b = write("ball.json", scene_with(floor + ", " + ball + field + "}"));
+    ASSERT_EQ(run("render " + b.string() + " -o " + out.string() + " --stats " + stats.string() + " --quiet").status, 0) << field;
+    EXPECT_EQ(nlohmann::json::parse(slurp(stats))["light_sampling"], used) << field;
+  }
+  expect_bad_scene(scene_with(floor + ", " + lamp + R"(, "sampling": "auto"})"),
                    {"objects[1].sampling", "not available in this build"});
   expect_bad_scene(scene_with(floor + R"(, {"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "white", "sampling": "area"})"),
                    {"objects[1].sampling", "only a light"});
@@ -318,7 +332,7 @@ TEST_F(Cli, PerLightSamplingField) {
 TEST_F(Cli, SamplesWritesTheContractsCsv) {
   const fs::path scene = fs::path(MCRT_SCENES_DIR) / "cornell_rect.json", out = dir / "s.csv";
   const std::string base = "samples " + scene.string() + " --light 0 --from 278,1,279 --normal 0,1,0 ";
-  for (const char* strategy : {"area", "solid-angle"}) {
+  for (const char* strategy : {"area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle"}) {
     ASSERT_EQ(run(base + "--n 2000 --seed 4 --light-sampling " + strategy + " -o " + out.string()).status, 0);
     std::istringstream csv(slurp(out));
     std::string line;
@@ -343,7 +357,8 @@ TEST_F(Cli, SamplesWritesTheContractsCsv) {
       ++rows;
     }
     EXPECT_EQ(rows, 2000);
-    // E[1/pdf] is the light's solid angle from (278, 1, 279): 0.0441 sr (README's extremes table), to 3 %.
+    // E[1/pdf] is, for every strategy, the light's solid angle from
+    // (278, 1, 279): 0.0441 sr (README's extremes table), to 3 %.
     EXPECT_NEAR(inv_pdf / rows, 0.04413, 0.03 * 0.04413) << strategy;
   }
   // To stdout, and from above the light (it faces down): rows of pdf 0.
@@ -370,7 +385,7 @@ TEST_F(Cli, EveryShippedSceneRenders) {
   for (const auto& e : fs::directory_iterator(MCRT_SCENES_DIR)) {
     if (e.path().extension() != ".json") continue;
     // Each integrator with another sample generator.
-    for (const char* strategy : {"area", "solid-angle"})
+    for (const char* strategy : {"area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle"})
       for (const auto& [integrator, sampler] : {std::pair{"mixture", "independent"}, {"nee", "stratified"}, {"mis", "sobol"}}) {
       const fs::path out = dir / (e.path().stem().string() + ".exr"), stats = dir / "s.json";
       const result r = run("render " + e.path().string() + " -o " + out.string() + " --width 24 --height 24 --spp 2 --light-sampling " +

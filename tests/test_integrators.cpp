@@ -275,6 +275,31 @@ TEST(Integrators, AgreeInMeanOnTheCornellScenes) {
     }
   }
 }
+
+// The cosine-aware strategies (projected solid angle; the bilinear pre-warp
+// where the shape has it) on scenes with each light shape: rectangle, disk,
+// sphere (cornell_sphere), and book 3's glass sphere as the mixture's
+// importance target; the same Welch test against the mixture.
+TEST(Integrators, AgreeInMeanWithCosineAwareStrategies) {
+  for (const char* name : {"cornell_rect", "cornell_disk_large", "cornell_sphere", "cornell_book3"}) {
+    for (const light_sampling strategy : {light_sampling::projected_solid_angle, light_sampling::bilinear_solid_angle}) {
+      if (strategy == light_sampling::bilinear_solid_angle && std::string(name) != "cornell_rect" &&
+          std::string(name) != "cornell_disk_large")
+        continue;
+      const cli::loaded_scene ls = cli::load_scene(std::string(MCRT_SCENES_DIR) + "/" + name + ".json", strategy);
+      const camera cam(ls.cam.lookfrom, ls.cam.lookat, ls.cam.vup, ls.cam.vfov,
+                       static_cast<float>(ls.cam.width) / static_cast<float>(ls.cam.height));
+      render_settings rs;
+      rs.width = rs.height = 16;
+      rs.spp = 16;
+      for (const int depth : {1, ls.max_depth}) {
+        rs.max_depth = depth;
+        expect_same_mean(ls.world, cam, rs, all_configs,
+                         std::string(name) + " " + std::string(to_string(strategy)) + " max depth " + std::to_string(depth));
+      }
+    }
+  }
+}
 #endif
 
 // Direct light only under next-event estimation on the unoccluded floor

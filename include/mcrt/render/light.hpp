@@ -3,11 +3,18 @@
 // sampling strategy, in one std::variant so a scene holds exactly the
 // strategies it uses and dispatch is a few compares, not a virtual call.
 #include <concepts>
+#include <type_traits>
 #include <variant>
 
 #include "mcrt/core/dispatch.hpp"
+#include "mcrt/sampling/bilinear_spherical_ellipse.hpp"
+#include "mcrt/sampling/bilinear_spherical_rectangle.hpp"
 #include "mcrt/sampling/ellipse_area.hpp"
+#include "mcrt/sampling/projected_rectangle.hpp"
+#include "mcrt/sampling/projected_spherical_cap.hpp"
+#include "mcrt/sampling/projected_spherical_ellipse.hpp"
 #include "mcrt/sampling/rect_area.hpp"
+#include "mcrt/sampling/sphere_area.hpp"
 #include "mcrt/sampling/sphere_cone.hpp"
 #include "mcrt/sampling/spherical_ellipse.hpp"
 #include "mcrt/sampling/spherical_ellipse_polar.hpp"
@@ -15,8 +22,35 @@
 
 namespace mcrt {
 
+// Every shape x strategy the renderer has. The dispatch (core/dispatch.hpp)
+// tests the alternatives in this order, so the strategies of the seed's
+// scenes come first and the cosine-aware ones, newer, after them: a scene
+// that does not use a strategy pays for it at most one predictable compare.
 using light = std::variant<rect_area_sampler, rect_solid_angle_sampler, ellipse_area_sampler,
-                           ellipse_solid_angle_sampler, ellipse_polar_solid_angle_sampler, sphere_cone_sampler>;
+                           ellipse_solid_angle_sampler, ellipse_polar_solid_angle_sampler, sphere_cone_sampler,
+                           rect_projected_solid_angle_sampler, sphere_projected_solid_angle_sampler,
+                           ellipse_projected_solid_angle_sampler, sphere_area_sampler,
+                           rect_bilinear_solid_angle_sampler, ellipse_bilinear_solid_angle_sampler>;
+
+// The strategy a light-sampling class implements (--stats, mcrt samples).
+template <class S>
+constexpr light_sampling strategy_of() {
+  if constexpr (std::is_same_v<S, rect_area_sampler> || std::is_same_v<S, ellipse_area_sampler> ||
+                std::is_same_v<S, sphere_area_sampler>)
+    return light_sampling::area;
+  else if constexpr (std::is_same_v<S, rect_projected_solid_angle_sampler> ||
+                     std::is_same_v<S, sphere_projected_solid_angle_sampler> ||
+                     std::is_same_v<S, ellipse_projected_solid_angle_sampler>)
+    return light_sampling::projected_solid_angle;
+  else if constexpr (std::is_same_v<S, rect_bilinear_solid_angle_sampler> ||
+                     std::is_same_v<S, ellipse_bilinear_solid_angle_sampler>)
+    return light_sampling::bilinear_solid_angle;
+  else
+    return light_sampling::solid_angle;
+}
+inline light_sampling strategy_of(const light& l) {
+  return dispatch(l, []<class S>(const S&) { return strategy_of<S>(); });
+}
 
 // The free functions light_pdf (render/pdf.hpp) and the integrators call:
 // the strategy's own members for a plain strategy, a static dispatch for the

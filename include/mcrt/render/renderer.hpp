@@ -32,7 +32,7 @@ struct render_settings {
   std::uint64_t seed = 0;
   unsigned threads = 0;  // 0: all hardware threads
   integrator_kind integrator = integrator_kind::mixture;
-  sampler_kind sampler = sampler_kind::independent;
+  sampler_kind sampler = sampler_kind::sobol;  // the most efficient in the study (README)
   light_choice choose = light_choice::power;       // nee, mis (path_settings)
   mis_heuristic heuristic = mis_heuristic::power;  // mis (path_settings)
 

@@ -23,6 +23,8 @@
 // every strategy through the free functions sample(l, o, n, u, s) and
 // pdf(l, o, n, dir) of render/light.hpp, which drop n for the strategies
 // that ignore it (area, solid angle).
+#include <string_view>
+
 #include "mcrt/core/math.hpp"
 
 namespace mcrt {
@@ -35,7 +37,28 @@ struct light_sample {
 
 // Which strategy a light is sampled with; --light-sampling chooses one for
 // every light of a scene.
-enum class light_sampling { area, solid_angle };
+//   area                  uniform on the light's surface (for a sphere: on
+//                         the part of its surface the observer sees);
+//   solid_angle           uniform in the solid angle the light subtends;
+//   projected_solid_angle proportional to cos theta at the receiver within
+//                         that solid angle (exact for rectangles and
+//                         spheres; for ellipses see README);
+//   bilinear_solid_angle  the solid-angle map pre-warped by a bilinear
+//                         approximation of cos theta on its unit square
+//                         (Hart et al. 2020, as pbrt-v4), a comparison
+//                         strategy for rectangles and ellipses.
+enum class light_sampling { area, solid_angle, projected_solid_angle, bilinear_solid_angle };
+
+// The command line's and the scene format's name of a strategy.
+constexpr std::string_view to_string(light_sampling s) {
+  switch (s) {
+    case light_sampling::area: return "area";
+    case light_sampling::solid_angle: return "solid-angle";
+    case light_sampling::projected_solid_angle: return "projected-solid-angle";
+    case light_sampling::bilinear_solid_angle: return "bilinear-solid-angle";
+  }
+  return "?";
+}
 
 // Area density -> solid-angle density (Shirley, "The Rest of Your Life",
 // sec. 9; Veach 1997, eq. 8.10): p_w = p_A d^2 / |cos theta_light|.

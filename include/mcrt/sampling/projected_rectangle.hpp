@@ -1,0 +1,544 @@
+#pragma once
+// Sampling a rectangle light in proportion to projected solid angle at a
+// receiver with unit normal n: density cos(theta) / Omega_proj per unit
+// SOLID ANGLE (cos(theta) = n . dir), i.e. 1 / Omega_proj per unit projected
+// solid angle, over the part of the light above the receiver's horizon. For
+// an unoccluded light of constant radiance L on a diffuse receiver the
+// estimate L cos(theta) / pdf = L Omega_proj has zero variance.
+//
+// Steps (per receiver point; the light's frame is cached by the strategy):
+//  1. The light frame of spherical_rectangle.hpp: o at the origin, the
+//     rectangle [x0, x1] x [y0, y1] in the plane z = -h, h > 0 (one-sided
+//     light: no sample behind it), n given by its components nL there.
+//  2. Clipping (Sutherland-Hodgman, one plane) by the receiver's horizon
+//     n . p > 0: the visible part is a convex polygon of 3, 4 or 5 vertices,
+//     each kept as a corner of the rectangle plus a short offset, so that
+//     differences of nearby vertices keep their relative precision. Clip
+//     points are where a rectangle edge crosses the horizon plane, at the
+//     fraction z_i / (z_i - z_j) of the edge (z the heights of its corners
+//     above that plane).
+//  3. Omega_proj in closed form: Lambert's formula (projected_polygon.hpp,
+//     (L)) on the clipped polygon. Every edge of the rectangle lies in a
+//     plane through o with an exactly known inward normal, (0, h, y0)/q0,
+//     -(h, 0, x1)/p1, -(0, h, y1)/q1, (h, 0, x0)/p0 (q_j = sqrt(h^2 + y_j^2),
+//     p_i = sqrt(h^2 + x_i^2)), and subtends from o the angle
+//     gamma = atan2(len q, q^2 + a b) of the segment [a, b] (length len) of
+//     its line at distance q; the horizon edge has the normal n itself.
+//     Lambert's sum is rewritten without its cancellation for small or
+//     distant lights (terms O(eps), sum O(eps^2)):
+//       Omega_proj = (1/2) sum_i sin(gamma_i) m_z,i + (1/2) sum_i (gamma_i - sin gamma_i) m_z,i
+//                  = -n . (1/2) sum_fan (v_i - v_0) x (v_{i+1} - v_0) + (1/2) sum_i (gamma_i - sin gamma_i) m_z,i   (C)
+//     The first sum is the projected area of the planar "chord" polygon of
+//     the unit vertex directions v_i (sin(gamma) m = v_i x v_{i+1} up to the
+//     winding), computed as a fan of differences v_i - v_0, each formed from
+//     the exact difference of the vertices on the light (V_i - V_0)/L_i -
+//     V_0 (L_i^2 - L_0^2)/(L_i L_0 (L_i + L_0)), L = |V|; the second is the
+//     sum of the elliptic segments between the arcs and their chords,
+//     gamma - sin(gamma) = gamma^3/6 - ... by its series for small gamma. For
+//     a small light every term of (C) is of the size of the result or
+//     smaller (the segments are O(eps^3)).
+//     For a thin sliver just above the horizon (a grazing normal) both forms
+//     cancel (terms O(1), result O(delta^2)); there the complement form (Z)
+//     of projected_polygon.hpp, whose terms are O(delta^2), is used.
+//  4. The map of projected_polygon.hpp (after Peters 2021) in the
+//     receiver's frame; the sampled direction is carried onto the light
+//     plane for its distance and clamped to the rectangle (rounding only).
+//
+// Thresholds and fallbacks. Each form's condition number K = (sum of the
+// magnitudes of its terms, including the cancelling parts of m_z) /
+// Omega_proj bounds its relative rounding error by a few K DBL_EPSILON,
+// for the closed form and for every sub-area the map evaluates. The map is
+// used while K <= max_condition for the form of its sub-areas (Lambert's,
+// or the complement form where Lambert's is worse): the density, the pdf
+// and the map then agree to ~1e-9 relative or better, below a float's
+// resolution. Where neither form is that accurate (lights below ~1e-11 sr,
+// small lights within ~1 degree of the horizon, views within ~1e-6 of the
+// light's plane with the receiver's normal close to the light's, degenerate
+// clips), the visible polygon is sampled uniformly by area with its exact
+// pdf d^3 / (h A_visible) per unit solid angle: for sample() and pdf()
+// alike, decided from (light, o, n) only, so the sample, the pdf returned
+// with it, pdf(o, n, dir) and the true density always agree.
+#include <algorithm>
+#include <array>
+#include <cfloat>
+#include <cmath>
+
+#include "mcrt/core/fast_math.hpp"
+#include "mcrt/geometry/rect.hpp"
+#include "mcrt/sampling/light_sample.hpp"
+#include "mcrt/sampling/projected_polygon.hpp"
+#include "mcrt/sampling/spherical_rectangle.hpp"
+
+namespace mcrt {
+
+namespace projected_rectangle_detail {
+
+// gamma - sin(gamma) for gamma in [0, pi], with sin(gamma) given: the
+// series gamma^3/6 - gamma^5/120 + ... below 0.25 (truncation < 1e-17
+// relative), the difference above (where it loses < 7 bits).
+inline double arc_minus_chord(double g, double sin_g) {
+  if (g >= 0.25) return g - sin_g;
+  const double g2 = g * g;
+  return g * g2 * (1.0 / 6.0 - g2 * (1.0 / 120.0 - g2 * (1.0 / 5040.0 - g2 * (1.0 / 362880.0 - g2 / 39916800.0))));
+}
+
+}  // namespace projected_rectangle_detail
+
+// Per-receiver set-up of the projected solid angle of a rectangle (steps
+// 1-3 of the header), the choice of method, and (with_map) the map.
+class projected_rectangle {
+ public:
+  enum class method : unsigned char { none, map, area };
+  // Largest condition number of the map's form (see the header): a few
+  // times 1e6 DBL_EPSILON ~ 1e-9 relative.
+  static constexpr double max_condition = 1e6;
+  // Below this condition number Lambert's sum itself is Omega_proj to a few
+  // times 1e3 DBL_EPSILON < 1e-12 relative, and the cancellation-free form
+  // (C) is not evaluated (a common light seen at a moderate distance).
+  static constexpr double direct_condition = 1e3;
+
+  projected_rectangle(const spherical_rectangle_detail::rect_frame& f, const vec3& corner, const vec3& o,
+                      const vec3& n, bool with_map = false)
+      : ex_(f.ex), ey_(f.ey), ez_(f.ez), w_(f.w), l_(f.l) {
+    const dvec3 d = dvec3(corner) - dvec3(o);  // exact: a difference of floats in double
+    h_ = -glm::dot(d, ez_);
+    x0_ = glm::dot(d, ex_);
+    y0_ = glm::dot(d, ey_);
+    x1_ = x0_ + w_;
+    y1_ = y0_ + l_;
+    // One-sided light: o strictly in front (also rejects NaN and degenerate
+    // rectangles, as spherical_rectangle does).
+    if (!(h_ > 0.0) || !(w_ * l_ > 0.0)) return;
+    nd_ = dvec3(n);
+    const double nl = glm::length(nd_);
+    if (!(nl > 0.0) || !std::isfinite(nl)) return;
+    nd_ /= nl;
+    nL_ = {glm::dot(nd_, ex_), glm::dot(nd_, ey_), glm::dot(nd_, ez_)};
+    clip();
+    if (count_ < 3) return;
+    closed_forms();
+    if (with_map && how_ == method::map) prepare_map();
+  }
+
+  method how() const { return how_; }
+  bool valid() const { return how_ != method::none; }
+  // Whether sample_offset() can return a point (with_map given for the map).
+  bool can_sample() const { return how_ == method::area || (how_ == method::map && map_ok_); }
+  // Omega_proj of the visible part (sr, projected; 0 if nothing is visible).
+  double projected_solid_angle() const { return omega_; }
+  // Area of the visible part on the light (the area fallback's normaliser).
+  double visible_area() const { return area_; }
+  int vertex_count() const { return count_; }
+  // Whether the map's sub-areas use the complement form (Z).
+  bool complement() const { return complement_; }
+  // Omega_proj by Lambert's sum, by (C) and by (Z) (0 if not computed).
+  double omega_lambert() const { return omega_lambert_; }
+  double omega_chord() const { return omega_chord_; }
+  double omega_complement() const { return omega_z_; }
+  // Condition numbers of Lambert's form, of (C), and of (Z) (0 if not computed).
+  double condition_lambert() const { return cond_lambert_; }
+  double condition_chord() const { return cond_chord_; }
+  double condition_complement() const { return cond_z_; }
+  double height() const { return h_; }
+  const dvec3& normal() const { return nd_; }
+
+  // u in [0,1)^2 -> point on the rectangle minus o (in double); false if
+  // there is nothing to sample. Needs with_map for the map.
+  bool sample_offset(vec2 u, dvec3& v) const {
+    if (how_ == method::area) {
+      v = to_offset(area_sample(dvec2(u)));
+      return true;
+    }
+    if (how_ != method::map || !map_ok_) return false;
+    const dvec3 x = poly_.sample(dvec2(u));
+    const dvec3 dir = x.x * t_ + x.y * b_ + x.z * nd_;
+    const double dz = -glm::dot(dir, ez_);
+    if (!(dz > 0.0)) return false;
+    const double t = h_ / dz;
+    const double px = std::clamp(t * glm::dot(dir, ex_), x0_, x1_);
+    const double py = std::clamp(t * glm::dot(dir, ey_), y0_, y1_);
+    v = to_offset({px, py});
+    return true;
+  }
+
+  // Density per unit SOLID ANGLE of the unit direction dir whose ray meets
+  // the rectangle at distance t: cos(theta) / Omega_proj on the map,
+  // t^3 / (h A_visible) on the area fallback, 0 below the horizon.
+  double pdf_direction(const dvec3& dir, double t) const {
+    if (how_ == method::none) return 0.0;
+    const double c = glm::dot(dir, nd_);
+    if (!(c > 0.0)) return 0.0;
+    if (how_ == method::map) return c / omega_;
+    return t * t * t / (h_ * area_);
+  }
+
+  // Point o + v of the visible part -> unit square; the inverse of
+  // sample_offset() (needs with_map for the map).
+  dvec2 invert_offset(const dvec3& v) const {
+    if (how_ == method::area) return area_invert({glm::dot(v, ex_), glm::dot(v, ey_)});
+    const dvec3 dir = v / glm::length(v);
+    return poly_.invert({glm::dot(dir, t_), glm::dot(dir, b_), glm::dot(dir, nd_)});
+  }
+
+  // Ray o + t dir (dir unit) against the rectangle, in the local frame, as
+  // spherical_rectangle::intersect; t is the distance to the hit.
+  bool intersect(const dvec3& dir, double& t) const {
+    if (!(h_ > 0.0)) return false;
+    const double dz = glm::dot(dir, ez_);
+    if (!(dz < 0.0)) return false;
+    t = h_ / -dz;
+    const double x = t * glm::dot(dir, ex_), y = t * glm::dot(dir, ey_);
+    return x >= x0_ && x <= x1_ && y >= y0_ && y <= y1_;
+  }
+
+ private:
+  static constexpr int max_vertices = projected_polygon::max_vertices;
+  static constexpr int horizon = 4;  // edge kind of the clipped edge along the horizon
+
+  // Corner i of the rectangle in the light plane: (x0, y0), (x1, y0), (x1, y1), (x0, y1).
+  static constexpr double corner_x[4] = {0.0, 1.0, 1.0, 0.0}, corner_y[4] = {0.0, 0.0, 1.0, 1.0};
+  dvec2 corner(int i) const { return {x0_ + corner_x[i] * w_, y0_ + corner_y[i] * l_}; }
+  // Edge i runs from corner i to corner i + 1 along dir(i), length len(i).
+  static dvec2 edge_dir(int i) {
+    constexpr double dx[4] = {1.0, 0.0, -1.0, 0.0}, dy[4] = {0.0, 1.0, 0.0, -1.0};
+    return {dx[i], dy[i]};
+  }
+  double edge_len(int i) const { return (i & 1) ? l_ : w_; }
+
+  // Vertex k in the light plane and the difference of two vertices formed
+  // from their corners (exact multiples of w and l) and their offsets.
+  dvec2 vertex(int k) const { return corner(base_[k]) + off_[k]; }
+  dvec2 vertex_difference(int a, int b) const {  // vertex(b) - vertex(a)
+    const dvec2 cd((corner_x[base_[b]] - corner_x[base_[a]]) * w_, (corner_y[base_[b]] - corner_y[base_[a]]) * l_);
+    return cd + (off_[b] - off_[a]);
+  }
+  dvec3 to_offset(const dvec2& p) const { return p.x * ex_ + p.y * ey_ - h_ * ez_; }
+
+  // Step 2: the part of the rectangle with n . p > 0.
+  void clip() {
+    double z[4];
+    for (int i = 0; i < 4; ++i) {
+      const dvec2 c = corner(i);
+      z[i] = c.x * nL_.x + c.y * nL_.y - h_ * nL_.z;
+    }
+    int k = 0;
+    const auto add_clip_point = [&](int i, double s, double oms, int kind, double seg) {
+      // On edge i at the fraction s from corner i (oms = 1 - s), kept
+      // relative to the nearer corner.
+      const int j = (i + 1) & 3;
+      if (s <= 0.5) {
+        base_[k] = i;
+        off_[k] = (s * edge_len(i)) * edge_dir(i);
+      } else {
+        base_[k] = j;
+        off_[k] = (-oms * edge_len(i)) * edge_dir(i);
+      }
+      kind_[k] = kind;
+      seg_[k] = seg;
+      height_[k] = 0.0;
+      ++k;
+    };
+    for (int i = 0; i < 4; ++i) {
+      const int j = (i + 1) & 3;
+      const bool in_i = z[i] > 0.0, in_j = z[j] > 0.0;
+      if (in_i) {
+        const double s = in_j ? 1.0 : z[i] / (z[i] - z[j]);
+        base_[k] = i;
+        off_[k] = {0.0, 0.0};
+        kind_[k] = i;
+        seg_[k] = s * edge_len(i);
+        height_[k] = z[i];
+        ++k;
+        if (!in_j) add_clip_point(i, s, -z[j] / (z[i] - z[j]), horizon, 0.0);
+      } else if (in_j) {
+        const double oms = z[j] / (z[j] - z[i]);
+        add_clip_point(i, -z[i] / (z[j] - z[i]), oms, i, oms * edge_len(i));
+      }
+    }
+    count_ = k;
+    whole_ = z[0] > 0.0 && z[1] > 0.0 && z[2] > 0.0 && z[3] > 0.0;
+  }
+
+  // Step 3: per-edge angles and normals, Lambert, (C), (Z), the choice.
+  void closed_forms() {
+    using namespace projected_rectangle_detail;
+    const std::array<double, 4> r = fast_math::sqrt4(h_ * h_ + y0_ * y0_, h_ * h_ + x1_ * x1_, h_ * h_ + y1_ * y1_,
+                                                     h_ * h_ + x0_ * x0_);  // q0, p1, q1, p0: distances of the edge lines
+    double lambert = 0.0, lambert_mag = 0.0, seg = 0.0, seg_mag = 0.0;
+    bool decentral = false;
+    for (int k = 0; k < count_; ++k) {
+      const int kn = k + 1 == count_ ? 0 : k + 1;
+      const dvec2 a = vertex(k), b = vertex(kn);
+      double Y, X, mz, mzmag;
+      dvec3 mL;
+      if (kind_[k] == horizon) {
+        const dvec2 dv = vertex_difference(k, kn);
+        const double cr = a.x * dv.y - a.y * dv.x;
+        Y = std::sqrt(h_ * h_ * glm::dot(dv, dv) + cr * cr);  // |A x B| = |A x (B - A)|
+        X = glm::dot(a, b) + h_ * h_;
+        mz = 1.0;
+        mzmag = 1.0;
+        mL = nL_;
+      } else {
+        const int e = kind_[k];
+        const double q = r[e];
+        const bool along_x = (e & 1) == 0;  // edges 0 and 2 run along x at y = y0, y1
+        const double pa = along_x ? a.x : a.y, pb = along_x ? b.x : b.y;
+        Y = seg_[k] * q;
+        X = q * q + pa * pb;
+        // Inward normals (0, h, y0)/q0, -(h, 0, x1)/p1, -(0, h, y1)/q1, (h, 0, x0)/p0.
+        const double sgn = e < 2 ? (e == 0 ? 1.0 : -1.0) : (e == 2 ? -1.0 : 1.0);
+        const double line = e == 0 ? y0_ : e == 1 ? x1_ : e == 2 ? y1_ : x0_;
+        const double nh = along_x ? nL_.y : nL_.x;
+        mL = along_x ? dvec3(0.0, sgn * h_ / q, sgn * line / q) : dvec3(sgn * h_ / q, 0.0, sgn * line / q);
+        mz = sgn * (h_ * nh + line * nL_.z) / q;
+        mzmag = (std::abs(h_ * nh) + std::abs(line * nL_.z)) / q;
+      }
+      const double R = std::sqrt(X * X + Y * Y);  // no overflow: |X|, |Y| are squared lengths of the scene, far below 1e150
+      const double g = fast_math::atan2_upper(Y, X);
+      gamma_[k] = g;
+      sin_[k] = Y / R;
+      cos_[k] = X / R;
+      mz_[k] = mz;
+      mL_[k] = mL;
+      decentral = decentral || mz < 0.0;
+      lambert += 0.5 * mz * g;
+      lambert_mag += 0.5 * mzmag * g;
+      const double amc = arc_minus_chord(g, sin_[k]);
+      seg += 0.5 * mz * amc;
+      seg_mag += 0.5 * mzmag * amc;
+    }
+    omega_lambert_ = lambert;
+    cond_lambert_ = lambert_mag / lambert;
+    // Visible area (for the fallback): a fan in the light plane.
+    area_ = 0.0;
+    for (int k = 1; k + 1 < count_; ++k) {
+      const dvec2 a = vertex_difference(0, k), b = vertex_difference(0, k + 1);
+      fan_[k] = 0.5 * std::abs(a.x * b.y - a.y * b.x);
+      area_ += fan_[k];
+    }
+    if (!std::isfinite(area_)) area_ = 0.0;
+    if (lambert > 0.0 && cond_lambert_ <= direct_condition) {
+      how_ = method::map;
+      complement_ = false;
+      omega_ = lambert;
+      return;
+    }
+    // (C): the chord polygon's area vector from the fan of differences.
+    dvec3 area_vec(0.0);
+    {
+      const dvec2 p0 = vertex(0);
+      const double l0 = std::sqrt(glm::dot(p0, p0) + h_ * h_);
+      const dvec3 v0(p0.x / l0, p0.y / l0, -h_ / l0);
+      dvec3 prev(0.0);
+      for (int k = 1; k < count_; ++k) {
+        const dvec2 pk = vertex(k), dk = vertex_difference(0, k);
+        const double lk = std::sqrt(glm::dot(pk, pk) + h_ * h_);
+        // v_k - v_0 = (V_k - V_0) / L_k - V_0 (L_k^2 - L_0^2) / (L_k L_0 (L_k + L_0)),
+        // L_k^2 - L_0^2 = (P_k - P_0) . (P_k + P_0); V_0 = L_0 v0.
+        const double dl = glm::dot(dk, pk + p0) / (lk * (lk + l0));
+        const dvec3 dv = dvec3(dk.x / lk, dk.y / lk, 0.0) - dl * v0;
+        if (k >= 2) area_vec += glm::cross(prev, dv);
+        prev = dv;
+      }
+      area_vec *= 0.5;
+    }
+    const double chord = -glm::dot(nL_, area_vec);
+    omega_chord_ = chord + seg;
+    cond_chord_ = (glm::length(area_vec) + seg_mag) / omega_chord_;
+
+    if (lambert > 0.0 && cond_lambert_ <= max_condition && omega_chord_ > 0.0) {
+      how_ = method::map;
+      complement_ = false;
+      omega_ = omega_chord_;
+      return;
+    }
+    if (decentral && complement_form() && cond_z_ <= max_condition) {
+      how_ = method::map;
+      complement_ = true;
+      omega_ = omega_z_;
+      return;
+    }
+    if (area_ > 0.0) {
+      how_ = method::area;
+      omega_ = omega_chord_ > 0.0 ? omega_chord_ : 0.0;
+    }
+  }
+
+  // The complement form (Z) of every edge; false if it has no area.
+  bool complement_form() {
+    double sum = 0.0, mag = 0.0;
+    for (int k = 0; k < count_; ++k) {
+      const int kn = k + 1 == count_ ? 0 : k + 1;
+      // 1 - |m_z| = |n x m|^2 / (1 + |m_z|), the cross product in the light frame.
+      const double omz = glm::dot(glm::cross(nL_, mL_[k]), glm::cross(nL_, mL_[k])) / (1.0 + std::abs(mz_[k]));
+      omz_[k] = kind_[k] == horizon ? 0.0 : omz;
+      const double zp = unit_height(k), zq = unit_height(kn), zz = zp * zq;
+      const double s = sin_[k], c = cos_[k];
+      // Delta phi - gamma = arg((P_xy . Q_xy + i |P_xy x Q_xy|) (cos g - i sin g)),
+      // P_xy . Q_xy = c - zz, |P_xy x Q_xy| = s |m_z| (projected_polygon.hpp).
+      const double im = s * (zz - omz_[k] * c), re = (c - zz) * c + s * s * (1.0 - omz_[k]);
+      const double a = std::atan2(im, re);
+      const double zk = 0.5 * (a + omz_[k] * gamma_[k]);
+      zterm_[k] = (mz_[k] < 0.0 ? 1.0 : -1.0) * zk;
+      sum += zterm_[k];
+      mag += 0.5 * (std::abs(a) + (2.0 * omz_[k] + zz) * gamma_[k]);
+    }
+    omega_z_ = sum;
+    cond_z_ = mag / sum;
+    return sum > 0.0 && std::isfinite(sum);
+  }
+
+  // z / |V| of vertex k (0 for clip points).
+  double unit_height(int k) const {
+    if (height_[k] == 0.0) return 0.0;
+    const dvec2 p = vertex(k);
+    return height_[k] / std::sqrt(glm::dot(p, p) + h_ * h_);
+  }
+
+  // Step 4: the polygon in the receiver's frame (Duff et al. 2017 basis).
+  void prepare_map() {
+    const double sign = std::copysign(1.0, nd_.z);
+    const double a = -1.0 / (sign + nd_.z), bb = nd_.x * nd_.y * a;
+    t_ = {1.0 + sign * nd_.x * nd_.x * a, sign * bb, -sign * nd_.x};
+    b_ = {bb, sign + nd_.y * nd_.y * a, -nd_.y};
+    // The light's axes in the receiver's frame.
+    const dvec3 EX(glm::dot(ex_, t_), glm::dot(ex_, b_), nL_.x), EY(glm::dot(ey_, t_), glm::dot(ey_, b_), nL_.y),
+        EZ(glm::dot(ez_, t_), glm::dot(ez_, b_), nL_.z);
+    poly_.count = count_;
+    poly_.complement = complement_;
+    poly_.condition = complement_ ? cond_z_ : cond_lambert_;
+    for (int k = 0; k < count_; ++k) {
+      const dvec2 p = vertex(k);
+      dvec3 v = p.x * EX + p.y * EY - h_ * EZ;
+      if (height_[k] == 0.0) v.z = 0.0;  // clip points lie on the horizon
+      poly_.v[k] = v / glm::length(v);
+      dvec3 m = mL_[k].x * EX + mL_[k].y * EY + mL_[k].z * EZ;
+      m.z = mz_[k];  // the value every classification used
+      poly_.m[k] = m;
+      poly_.gamma[k] = gamma_[k];
+      poly_.one_minus_mz[k] = complement_ ? omz_[k] : 0.0;
+      poly_.term[k] = complement_ ? zterm_[k] : 0.5 * mz_[k] * gamma_[k];
+    }
+    map_ok_ = poly_.prepare();
+  }
+
+  // Area fallback: uniform on the rectangle when it is whole, else on the
+  // fan of triangles (v0, v_k, v_k+1) of the visible polygon.
+  dvec2 area_sample(dvec2 u) const {
+    if (whole_) return {x0_ + u.x * w_, y0_ + u.y * l_};
+    double target = u.x * area_;
+    int k = 1;
+    while (k + 2 < count_ && target > fan_[k]) target -= fan_[k++];
+    const double s = std::sqrt(std::clamp(target / fan_[k], 0.0, 1.0));
+    const dvec2 a = vertex_difference(0, k), b = vertex_difference(0, k + 1);
+    return vertex(0) + s * ((1.0 - u.y) * a + u.y * b);
+  }
+  dvec2 area_invert(const dvec2& p) const {
+    if (whole_) return {std::clamp((p.x - x0_) / w_, 0.0, 1.0), std::clamp((p.y - y0_) / l_, 0.0, 1.0)};
+    // The fan triangle whose barycentric coordinates (al, be) in the basis
+    // (v_k - v_0, v_k+1 - v_0) are least negative; s = al + be, u2 = be / s.
+    const dvec2 q = p - vertex(0);
+    double before = 0.0, best = -infinity, u1 = 1.0, u2 = 1.0;
+    for (int k = 1; k + 1 < count_; ++k) {
+      const dvec2 a = vertex_difference(0, k), b = vertex_difference(0, k + 1);
+      const double det = a.x * b.y - a.y * b.x;
+      const double al = (q.x * b.y - q.y * b.x) / det, be = (a.x * q.y - a.y * q.x) / det;
+      const double inside = std::min({al, be, 1.0 - al - be});
+      if (inside > best) {
+        best = inside;
+        const double s = std::clamp(al + be, 0.0, 1.0);
+        u1 = (before + s * s * fan_[k]) / area_;
+        u2 = al + be > 0.0 ? be / (al + be) : 0.0;
+      }
+      before += fan_[k];
+    }
+    return {std::clamp(u1, 0.0, 1.0), std::clamp(u2, 0.0, 1.0)};
+  }
+
+  dvec3 ex_, ey_, ez_;
+  double w_ = 0.0, l_ = 0.0, x0_ = 0.0, x1_ = 0.0, y0_ = 0.0, y1_ = 0.0, h_ = 0.0;
+  dvec3 nd_{0.0, 0.0, 1.0}, nL_{0.0, 0.0, 1.0}, t_{1.0, 0.0, 0.0}, b_{0.0, 1.0, 0.0};
+  int count_ = 0;
+  std::array<int, max_vertices> base_{}, kind_{};
+  std::array<dvec2, max_vertices> off_{};
+  std::array<dvec3, max_vertices> mL_{};
+  std::array<double, max_vertices> seg_{}, height_{}, gamma_{}, sin_{}, cos_{}, mz_{}, omz_{}, zterm_{}, fan_{};
+  double omega_ = 0.0, omega_lambert_ = 0.0, omega_chord_ = 0.0, omega_z_ = 0.0, area_ = 0.0;
+  double cond_lambert_ = 0.0, cond_chord_ = 0.0, cond_z_ = 0.0;
+  bool complement_ = false, map_ok_ = false, whole_ = false;  // whole_: nothing clipped
+  method how_ = method::none;
+  projected_polygon poly_;
+};
+
+// Light-sampling strategy: exact projected-solid-angle sampling of a
+// rectangle clipped at the receiver's horizon (projected_rectangle above),
+// with the interface of light_sample.hpp's normal-aware form. One-sided: no
+// sample and pdf 0 behind the light, in its plane, or where the light lies
+// wholly below the horizon of n.
+struct rect_projected_solid_angle_sampler {
+  rect shape;  // fixed after construction (the frame below is derived from it)
+
+  explicit rect_projected_solid_angle_sampler(const rect& r)
+      : shape(r), frame_(spherical_rectangle_detail::make_rect_frame(r)) {}
+
+  bool faces(const vec3& o) const {
+    const dvec3 n = glm::cross(dvec3(shape.e1), dvec3(shape.e2));
+    return glm::dot(dvec3(o) - dvec3(shape.corner), n) * double(glm::dot(dvec3(n), dvec3(shape.n))) > 0.0;
+  }
+
+  bool sample(const vec3& o, const vec3& n, vec2 u, light_sample& s) const {
+    const projected_rectangle pr(frame_, shape.corner, o, n, true);
+    dvec3 v;
+    if (!pr.sample_offset(u, v)) return false;
+    const double d = glm::length(v);
+    if (!(d > 0.0)) return false;
+    const vec3 dir(v / d);
+    // The pdf of the float direction returned, computed as pdf() computes
+    // it (a direction that rounds to the horizon gets no sample).
+    const double p = pr.pdf_direction(dvec3(dir), d);
+    if (!(p > 0.0) || !(p <= double(FLT_MAX))) return false;
+    s.dir = dir;
+    s.dist = float(d);
+    s.pdf = float(p);
+    return true;
+  }
+
+  // Density per unit SOLID ANGLE at o of the unit direction dir for the
+  // receiver's normal n. The ray test comes first, so a direction that
+  // misses costs no set-up.
+  float pdf(const vec3& o, const vec3& n, const vec3& dir) const {
+    const dvec3 d = dvec3(shape.corner) - dvec3(o);
+    const double h = -glm::dot(d, frame_.ez);
+    if (!(h > 0.0)) return 0.0f;
+    const dvec3 dd(dir);
+    const double dz = glm::dot(dd, frame_.ez);
+    if (!(dz < 0.0)) return 0.0f;
+    const double t = h / -dz;
+    const double x = t * glm::dot(dd, frame_.ex) - glm::dot(d, frame_.ex);
+    const double y = t * glm::dot(dd, frame_.ey) - glm::dot(d, frame_.ey);
+    if (!(x >= 0.0 && x <= frame_.w && y >= 0.0 && y <= frame_.l)) return 0.0f;
+    if (!(glm::dot(dd, dvec3(n)) > 0.0)) return 0.0f;
+    const projected_rectangle pr(frame_, shape.corner, o, n);
+    const double p = pr.pdf_direction(dd, t);
+    return p <= double(FLT_MAX) ? float(p) : 0.0f;
+  }
+
+  // Unit direction dir -> the unit-square point sample() maps onto it
+  // (projected_polygon::invert, or the area fallback's inverse); false (u
+  // untouched) where pdf() is 0.
+  bool invert(const vec3& o, const vec3& n, const vec3& dir, vec2& u) const {
+    const projected_rectangle pr(frame_, shape.corner, o, n, true);
+    if (!pr.can_sample()) return false;
+    const dvec3 dd(dir);
+    double t;
+    if (!pr.intersect(dd, t) || !(pr.pdf_direction(dd, t) > 0.0)) return false;
+    u = vec2(pr.invert_offset(t * dd));
+    return true;
+  }
+
+ private:
+  spherical_rectangle_detail::rect_frame frame_;
+};
+
+}  // namespace mcrt
