@@ -13,8 +13,9 @@
 // (corner weights w_ij > 0, i for the first coordinate), then carried onto
 // the spherical ellipse by the exact parallel map, whose density is 1 / Omega
 // per unit solid angle. The composition has the density
-//   p(omega) = f(M^-1(omega)) / Omega   per unit SOLID ANGLE,
-// exact whatever the weights (only the variance depends on them), and is
+//   p(omega) = f(M^-1(omega)) / Omega   per unit SOLID ANGLE
+// above the receiver's horizon (0 below it, see "The horizon"), exact
+// whatever the weights (only the variance depends on them), and is
 // inverted by the parallel map's inverse followed by the bilinear inverse.
 //
 // The bilinear warp itself (square_to_bilinear / _pdf / bilinear_to_square)
@@ -62,12 +63,16 @@
 // the horizon, all of whose cosines are small, keeps its fitted shape. If no
 // weight is positive the warp is the identity (all weights 1).
 //
-// The horizon. The warp is not clipped: where the light is partly below the
-// receiver's horizon (cos theta < 0), those directions keep a nonzero density
-// (at least the floor) and are sampled; the integrator discards them (the
-// cosine factor is 0 there). A light wholly below the horizon of n gets no
-// sample and pdf 0: the largest n . (x - o) over the ellipse, n . (c - o) +
-// sqrt((n . a1)^2 + (n . a2)^2) (in double), is <= 0.
+// The horizon. The spherical ellipse covers the whole light, also the part
+// below the receiver's horizon. A sampled direction with n . omega <= 0 (the
+// float direction, tested in double) returns no sample, and pdf() is 0
+// there: the sampler is then a sub-probability density on the visible part
+// (its mass is the bilinear-weighted fraction of the solid angle above the
+// horizon), which keeps every estimate unbiased (a missing sample
+// contributes 0, as the integrand would), as bilinear_spherical_rectangle.hpp
+// does. A light wholly below the horizon of n gets no sample and pdf 0
+// without any set-up: the largest n . (x - o) over the ellipse,
+// n . (c - o) + sqrt((n . a1)^2 + (n . a2)^2) (in double), is <= 0.
 //
 // Fallbacks are the solid-angle sampler's (make_ellipse_cone): where the
 // spherical map is unreliable the light is sampled by area with the exact
@@ -176,8 +181,9 @@ struct ellipse_bilinear_solid_angle_sampler {
 
   // The point on the light (ellipse coordinates: centre + x a1 + y a2)
   // that sample() maps u to, with its density per unit solid angle, in
-  // double; false where sample() returns false. The float sample is taken
-  // from it.
+  // double; false where sample() returns false (the horizon tested in
+  // double here, on the float direction there: they differ only within a
+  // float rounding of the horizon). For tests.
   bool sample_point(const vec3& o, const vec3& n, vec2 u, dvec2& xe, double& pdf) const {
     if (!shape.faces(o) || ellipse_below_horizon(frame_, o, n)) return false;
     const ellipse_cone cone = make_ellipse_cone<solver>(shape, frame_, o);
@@ -190,20 +196,27 @@ struct ellipse_bilinear_solid_angle_sampler {
       const dvec3 v = dvec3(p) - dvec3(o);
       const double d2 = glm::dot(v, v), h = glm::dot(dvec3(o) - frame_.center, frame_.n);
       pdf = d2 * std::sqrt(d2) / (h * static_cast<double>(shape.area));
-      return true;
+      return glm::dot(v, dvec3(n)) > 0.0;  // below the horizon: no sample
     }
     const bilinear_weights w = spherical_ellipse_cosine_weights(cone.se, ellipse_cone_normal(cone, n));
     const dvec2 uw = square_to_bilinear(dvec2(u), w);
     xe = cone.ellipse_coords(square_to_spherical_ellipse<solver>(uw, cone.se, cone.omega));
     pdf = square_to_bilinear_pdf(uw, w) * square_to_spherical_ellipse_pdf(cone.omega);
-    return true;
+    const dvec3 v = frame_.center - dvec3(o) + xe.x * frame_.a1 + xe.y * frame_.a2;
+    return glm::dot(v, dvec3(n)) > 0.0;  // below the horizon: no sample
   }
 
   bool sample(const vec3& o, const vec3& n, vec2 u, light_sample& s) const {
     if (!shape.faces(o) || ellipse_below_horizon(frame_, o, n)) return false;
     const ellipse_cone cone = make_ellipse_cone<solver>(shape, frame_, o);
     if (cone.mode == ellipse_cone_mode::none) return false;
-    if (cone.mode == ellipse_cone_mode::area) return ellipse_area_sampler{shape}.sample(o, u, s);
+    if (cone.mode == ellipse_cone_mode::area) {
+      light_sample t;
+      if (!ellipse_area_sampler{shape}.sample(o, u, t)) return false;
+      if (!(glm::dot(dvec3(t.dir), dvec3(n)) > 0.0)) return false;  // below the horizon
+      s = t;
+      return true;
+    }
     const bilinear_weights w = spherical_ellipse_cosine_weights(cone.se, ellipse_cone_normal(cone, n));
     const dvec2 uw = square_to_bilinear(dvec2(u), w);
     dvec2 xe = cone.ellipse_coords(square_to_spherical_ellipse<solver>(uw, cone.se, cone.omega));
@@ -216,15 +229,18 @@ struct ellipse_bilinear_solid_angle_sampler {
     s.dir = vec3(v / len);
     s.dist = static_cast<float>(len);
     s.pdf = static_cast<float>(pdf);
+    if (!(glm::dot(dvec3(s.dir), dvec3(n)) > 0.0)) return false;  // below the horizon
     return std::isfinite(s.pdf) && s.pdf > 0.0f && all_finite(s.dir);
   }
 
   // Density per unit SOLID ANGLE at o (normal n) of the unit direction dir:
-  // the bilinear density at the parallel map's inverse of dir over Omega.
+  // the bilinear density at the parallel map's inverse of dir over Omega;
+  // 0 below the horizon, behind the light, or where the ray misses.
   // The ray test comes first, as in the solid-angle samplers.
   float pdf(const vec3& o, const vec3& n, const vec3& dir) const {
     float t;
     if (!shape.faces(o) || !shape.intersect({o, dir}, 0.0f, infinity, t)) return 0.0f;
+    if (!(glm::dot(dvec3(dir), dvec3(n)) > 0.0)) return 0.0f;  // below the horizon: no sample there
     if (ellipse_below_horizon(frame_, o, n)) return 0.0f;
     const ellipse_cone cone = make_ellipse_cone<solver>(shape, frame_, o);
     if (cone.mode == ellipse_cone_mode::none) return 0.0f;

@@ -114,6 +114,9 @@ struct projected_polygon {
   // Newton's residual tolerance, relative to Omega_proj (see the header).
   static constexpr double newton_tolerance = 1e-12;
   static constexpr int newton_max_steps = 60;
+  // Safety factor on the predicted residual of a last, unevaluated Newton
+  // step (see sample_decentral).
+  static constexpr double newton_margin = 100.0;
 
   int count = 0;
   std::array<dvec3, max_vertices> v{};              // unit vertex directions, z >= 0
@@ -161,24 +164,11 @@ struct projected_polygon {
     }
     for (int i = 1; i < count; ++i)  // insertion sort by azimuth
       for (int j = i; j > 0 && psi_[order_[j]] < psi_[order_[j - 1]]; --j) std::swap(order_[j], order_[j - 1]);
-    // A at the sorted vertex azimuths: the edges wholly before contribute
-    // their whole term, the one edge (of the other chain) straddling the
-    // azimuth a partial one.
-    cum_[0] = 0.0;
-    for (int j = 1; j < count; ++j) {
-      const int k = order_[j];
-      const dvec2 d = xy(v[k]);
-      double a = 0.0;
-      for (int e = 0; e < count; ++e) {
-        const int lo = lo_vertex(e), hi = next(e) == lo ? e : next(e);
-        if (psi_[hi] <= psi_[k])
-          a += term[e];
-        else if (psi_[lo] < psi_[k])
-          a += partial(e, lo, d);
-      }
-      cum_[j] = std::max(a, cum_[j - 1]);
-    }
-    total_ = cum_[count - 1];
+    // A at the last sorted vertex: every term. A at the others is found
+    // by sample() only as far as it needs (area_at_vertex).
+    double sum = 0.0;
+    for (int e = 0; e < count; ++e) sum += term[e];
+    total_ = sum;
     return total_ > 0.0 && std::isfinite(total_);
   }
 
@@ -236,6 +226,23 @@ struct projected_polygon {
   int next(int i) const { return i + 1 == count ? 0 : i + 1; }
   // The endpoint of edge e with the smaller azimuth (decentral).
   int lo_vertex(int e) const { return psi_[next(e)] < psi_[e] ? next(e) : e; }
+
+  // A at the azimuth of sorted vertex j (decentral): the edges wholly
+  // before contribute their whole term, the one edge (of the other chain)
+  // straddling the azimuth a partial one.
+  double area_at_vertex(int j) const {
+    const int k = order_[j];
+    const dvec2 d = xy(v[k]);
+    double a = 0.0;
+    for (int e = 0; e < count; ++e) {
+      const int lo = lo_vertex(e), hi = next(e) == lo ? e : next(e);
+      if (psi_[hi] <= psi_[k])
+        a += term[e];
+      else if (psi_[lo] < psi_[k])
+        a += partial(e, lo, d);
+    }
+    return a;
+  }
 
   // Edge e's signed share of A from its vertex lo (unit, on the edge) to the
   // azimuth of d (any length): (1/2) m_z gamma by (A), or -sign(m_z) Z.
@@ -371,14 +378,22 @@ struct projected_polygon {
   }
 
   dvec3 sample_decentral(double target, double u2) const {
+    // The sector of the target: A at the sorted vertices, kept monotone,
+    // up to the first one beyond the target (the last one's is total_).
     int j = 0;
-    while (j + 2 < count && cum_[j + 1] <= target) ++j;
+    double a0 = 0.0, a1 = total_;
+    for (; j + 2 < count; ++j) {
+      a1 = std::max(area_at_vertex(j + 1), a0);
+      if (a1 > target) break;
+      a0 = a1;
+      a1 = total_;
+    }
     sector sc;
     set_sector(j, sc);
     // Initial guess: A on the chord modelled by a quadratic with the exact
     // end slopes, scaled to the sector's area (the "quad" initialisation of
     // [P21] in spirit: the region between straight chords).
-    const double a0 = cum_[j], span = cum_[j + 1] - cum_[j];
+    const double span = a1 - a0;
     double t = 0.0;
     if (span > 0.0) {
       double f0, f1;
@@ -391,18 +406,27 @@ struct projected_polygon {
       const double den = a + std::sqrt(std::max(disc, 0.0));
       t = (k > 0.0 && disc >= 0.0 && den > 0.0) ? std::clamp(2.0 * frac / den, 0.0, 1.0) : frac;
       // Safeguarded Newton on A(t) = target within the bracket [0, 1].
+      // Once two consecutive Newton steps have shown the quadratic
+      // convergence |f_next| ~ C f^2 (C = |f| / f_prev^2 measured), a step
+      // whose predicted residual C f^2 is below tol / newton_margin is
+      // taken without evaluating A again.
       const double tol = std::max(newton_tolerance, 4.0 * DBL_EPSILON * condition) * total_;
-      double lo = 0.0, hi = 1.0;
+      double lo = 0.0, hi = 1.0, f_prev = 0.0;
       for (int it = 0; it < newton_max_steps; ++it) {
         double deriv;
         const double f = evaluate(sc, t, deriv) - target;
         if (std::abs(f) <= tol) break;
         (f > 0.0 ? hi : lo) = t;
         double tn = t - f / deriv;
-        if (!(tn > lo && tn < hi)) tn = 0.5 * (lo + hi);  // also catches deriv = 0 and NaN
+        const bool newton = tn > lo && tn < hi;  // false also for deriv = 0 and NaN
+        if (!newton) tn = 0.5 * (lo + hi);
         const bool tiny = std::abs(tn - t) <= 4.0 * DBL_EPSILON * std::max(t, DBL_MIN);
         t = tn;
         if (tiny || hi - lo <= 4.0 * DBL_EPSILON) break;
+        if (newton && f_prev != 0.0 && std::abs(f) < std::abs(f_prev) &&
+            (std::abs(f) / (f_prev * f_prev)) * f * f * newton_margin <= tol)
+          break;
+        f_prev = newton ? f : 0.0;
       }
     }
     const dvec2 d = unit((1.0 - t) * sc.b0 + t * sc.b1);
@@ -424,7 +448,7 @@ struct projected_polygon {
   bool central_ = false;
   double total_ = 0.0, orient_ = 1.0;
   dvec2 ref_{1.0, 0.0};
-  std::array<double, max_vertices> psi_{}, cum_{};
+  std::array<double, max_vertices> psi_{}, cum_{};  // cum_: central map only
   std::array<int, max_vertices> order_{};
 };
 

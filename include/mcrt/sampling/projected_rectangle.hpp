@@ -24,8 +24,9 @@
 //     p_i = sqrt(h^2 + x_i^2)), and subtends from o the angle
 //     gamma = atan2(len q, q^2 + a b) of the segment [a, b] (length len) of
 //     its line at distance q; the horizon edge has the normal n itself.
-//     Lambert's sum is rewritten without its cancellation for small or
-//     distant lights (terms O(eps), sum O(eps^2)):
+//     Where its condition number is at most direct_condition, Lambert's sum
+//     is used as is; otherwise it is rewritten without its cancellation
+//     for small or distant lights (terms O(eps), sum O(eps^2)):
 //       Omega_proj = (1/2) sum_i sin(gamma_i) m_z,i + (1/2) sum_i (gamma_i - sin gamma_i) m_z,i
 //                  = -n . (1/2) sum_fan (v_i - v_0) x (v_{i+1} - v_0) + (1/2) sum_i (gamma_i - sin gamma_i) m_z,i   (C)
 //     The first sum is the projected area of the planar "chord" polygon of
