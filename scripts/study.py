@@ -147,7 +147,11 @@ CSV_COLUMNS = ["scene", "strategy", "integrator", "sampler", "max_depth", "spp",
                "seconds", "rmse", "mse", "relmse"]
 # The CSV of the earlier, single-integrator study: read, then rewritten as CSV_COLUMNS.
 OLD_CSV_COLUMNS = ["scene", "strategy", "spp", "seed", "seconds", "rmse", "mse", "relmse"]
-STRATEGIES = ["area", "solid-angle"]
+STRATEGIES = ["area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle"]
+# The default sweep (the committed report); the others by --strategies.
+DEFAULT_STRATEGIES = ["area", "solid-angle"]
+# References with --ref-strategy auto: the first this mcrt has for the scene.
+REF_STRATEGY_PREFERENCE = ["solid-angle", "area"]
 INTEGRATORS = ["mixture", "nee", "mis"]
 SAMPLERS = ["independent", "stratified", "sobol"]
 DEPTH_MODES = ["global", "direct"]
@@ -192,6 +196,8 @@ COMMON_PLOTS = ["rmse_vs_spp.png", "time_vs_spp.png", "rmse_vs_time.png", "effic
 STRATEGY_STYLE = {
     "area": {"color": "tab:blue", "label": "area"},
     "solid-angle": {"color": "tab:orange", "label": "solid angle"},
+    "projected-solid-angle": {"color": "tab:green", "label": "projected solid angle"},
+    "bilinear-solid-angle": {"color": "tab:purple", "label": "bilinear solid angle"},
 }
 
 SAMPLER_DESCRIPTIONS = {
@@ -211,7 +217,7 @@ NOT_AVAILABLE_MARKER = "not available in this build"
 # work, and rough relative costs per sample (mixture, global depth = 1).
 PROCESS_OVERHEAD_SAMPLES = 1_000_000
 INTEGRATOR_COST = {"mixture": 1.0, "nee": 1.8, "mis": 1.8}
-STRATEGY_COST = {"area": 1.0, "solid-angle": 1.9}
+STRATEGY_COST = {"area": 1.0, "solid-angle": 1.9, "projected-solid-angle": 2.5, "bilinear-solid-angle": 2.2}
 DIRECT_COST = 0.55
 
 
@@ -398,7 +404,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="scene names in scenes/ or paths to scene files "
                    f"(default: {' '.join(DEFAULT_SCENES)})")
     p.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=None,
-                   help="light-sampling strategies (default: both)")
+                   help="light-sampling strategies (default: area solid-angle)")
     p.add_argument("--integrators", nargs="+", choices=INTEGRATORS, default=None,
                    help="integrators (default: all three; --quick: "
                    f"{' '.join(QUICK_INTEGRATORS)})")
@@ -463,7 +469,7 @@ def resolve_settings(args: argparse.Namespace, argv: list[str]) -> Settings:
         bench=bench,
         out=(args.out or (QUICK_OUT if quick else DEFAULT_OUT)).resolve(),
         scenes=args.scenes or list(DEFAULT_SCENES),
-        strategies=args.strategies or list(STRATEGIES),
+        strategies=args.strategies or list(DEFAULT_STRATEGIES),
         integrators=args.integrators or list(QUICK_INTEGRATORS if quick else INTEGRATORS),
         samplers=args.samplers or list(QUICK_SAMPLERS if quick else SAMPLERS),
         depths=args.depths or list(DEPTH_MODES),
@@ -697,7 +703,7 @@ def diff(settings: Settings, image: Path, reference: Path) -> dict[str, float]:
 # --------------------------------------------------------------- references
 def reference_strategies(settings: Settings) -> list[str]:
     """The strategies a reference may use, preferred first (auto: solid angle, then area)."""
-    return STRATEGIES[::-1] if settings.ref_strategy == "auto" else [settings.ref_strategy]
+    return list(REF_STRATEGY_PREFERENCE) if settings.ref_strategy == "auto" else [settings.ref_strategy]
 
 
 def reference_key(settings: Settings, scene: SceneInfo, max_depth: int, strategy: str,

@@ -84,6 +84,19 @@ struct chi2_options {
   // miss the light; see rim_miss_fraction(). Such samples are left out of
   // the histogram and counted in the report.
   double zero_pdf_fraction = 0.0;
+  // chi2_test_unit_square: relative tolerance of the adaptive Gauss rule that
+  // integrates the density over each cell. A density computed from a float
+  // pdf() carries ~1e-7 relative rounding noise, which no rule can integrate
+  // below: at a tighter tolerance the rule subdivides every cell to its depth
+  // limit (4^8 sub-cells), which costs hours and no accuracy. Expected
+  // counts need only ~1e-5 relative accuracy for a chi-square test of 1e6
+  // samples (the statistic's own noise is ~1e-3 of it).
+  double quadrature_tolerance = 1e-7;
+  // chi2_test_unit_square: depth limit of that rule's subdivision (4^depth
+  // sub-cells at most per cell). A density with a jump inside the square
+  // (float directions that round off the light's rim get pdf 0) refines along
+  // the jump to this depth in every cell it crosses.
+  int quadrature_max_depth = 8;
 };
 
 struct chi2_result {
@@ -719,7 +732,7 @@ chi2_result chi2_test_unit_square(Sample&& sample, Density&& density, const chi2
     const double um = 0.5 * (u0 + u1), vm = 0.5 * (v0 + v1);
     const double q[4] = {rule(u0, um, v0, vm), rule(um, u1, v0, vm), rule(u0, um, vm, v1), rule(um, u1, vm, v1)};
     const double parts = q[0] + q[1] + q[2] + q[3];
-    if (depth >= 8 || std::abs(parts - whole) <= 1e-7 * std::abs(parts) + 1e-16) return parts;
+    if (depth >= opt.quadrature_max_depth || std::abs(parts - whole) <= opt.quadrature_tolerance * std::abs(parts) + 1e-16) return parts;
     return self(self, u0, um, v0, vm, q[0], depth + 1) + self(self, um, u1, v0, vm, q[1], depth + 1) +
            self(self, u0, um, vm, v1, q[2], depth + 1) + self(self, um, u1, vm, v1, q[3], depth + 1);
   };
