@@ -88,6 +88,7 @@
 #include "mcrt/sampling/ellipse_area.hpp"
 #include "mcrt/sampling/light_sample.hpp"
 #include "mcrt/sampling/spherical_ellipse.hpp"
+#include "mcrt/sampling/warp.hpp"
 
 namespace mcrt {
 
@@ -95,17 +96,6 @@ namespace mcrt {
 
 // Corner weights w[i][j] of the bilinear density at (x, y) = (i, j), all > 0.
 using bilinear_weights = std::array<std::array<double, 2>, 2>;
-
-// Linear density on [0, 1] with end values a, b >= 0, a + b > 0: sample,
-// density, inverse (the CDF). See the header comment.
-inline double square_to_linear(double u, double a, double b) {
-  const double x = u * (a + b) / (a + std::sqrt((1.0 - u) * a * a + u * b * b));
-  return std::clamp(x, 0.0, 1.0);
-}
-inline double square_to_linear_pdf(double x, double a, double b) { return 2.0 * ((1.0 - x) * a + x * b) / (a + b); }
-inline double linear_to_square(double x, double a, double b) {
-  return std::clamp(x * (a * (2.0 - x) + b * x) / (a + b), 0.0, 1.0);
-}
 
 // u -> (x, y): x from the marginal, y from the conditional.
 inline dvec2 square_to_bilinear(dvec2 u, const bilinear_weights& w) {

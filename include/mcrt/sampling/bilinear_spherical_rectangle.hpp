@@ -66,6 +66,7 @@
 #include "mcrt/geometry/rect.hpp"
 #include "mcrt/sampling/light_sample.hpp"
 #include "mcrt/sampling/spherical_rectangle.hpp"
+#include "mcrt/sampling/warp.hpp"
 
 namespace mcrt {
 
@@ -74,17 +75,6 @@ namespace bilinear_rect_detail {
 // Weights at the corners (0,0), (1,0), (0,1), (1,1) of the unit square, in
 // pbrt-v4's order; all > 0.
 using corner_weights = std::array<double, 4>;
-
-// Linear density on [0, 1] with end values a, b > 0: sample, pdf (per unit
-// length), inverse.
-inline double square_to_linear(double u, double a, double b) {
-  const double x = u * (a + b) / (a + std::sqrt((1.0 - u) * a * a + u * b * b));
-  return std::clamp(x, 0.0, 1.0);
-}
-inline double square_to_linear_pdf(double x, double a, double b) { return 2.0 * ((1.0 - x) * a + x * b) / (a + b); }
-inline double linear_to_square(double x, double a, double b) {
-  return std::clamp(x * (a * (2.0 - x) + b * x) / (a + b), 0.0, 1.0);
-}
 
 // Bilinear density on [0,1]^2 (pbrt-v4 order: y from the marginal, x from
 // the conditional): sample, pdf (per unit area of the square), inverse.

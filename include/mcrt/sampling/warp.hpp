@@ -1,7 +1,11 @@
 #pragma once
 // Warps from the unit square to directions, each with its pdf and inverse
 // (names after Mitsuba 3's core/warp.h). Directions are in a local frame
-// with z as the axis.
+// with z as the axis. Also the 1-D linear warp the bilinear pre-warps of
+// the spherical rectangle and ellipse are built from.
+#include <algorithm>
+#include <cmath>
+
 #include "mcrt/core/math.hpp"
 
 namespace mcrt {
@@ -72,6 +76,22 @@ inline vec2 uniform_cone_to_square(const vec3& d, float one_minus_cos) {
   if (phi < 0.0f) phi += two_pi;
   const float omc = (d.x * d.x + d.y * d.y) / (1.0f + d.z);  // 1 - cos, cancellation-free
   return {omc / one_minus_cos, phi / two_pi};
+}
+
+// --- linear density on [0, 1] with end values a, b >= 0, a + b > 0 (the
+// marginal and conditional of a bilinear density; Hart et al. 2020,
+// sec. 4.1, pbrt-v4's SampleLinear): sample, density per unit LENGTH,
+// inverse (the CDF). The sample is the CDF's quadratic root in the form
+// u (a + b) / (a + sqrt((1 - u) a^2 + u b^2)), which does not cancel for
+// a ~ b (where the quadratic's leading coefficient b - a vanishes); clamped
+// because rounding may step past [0, 1].
+inline double square_to_linear(double u, double a, double b) {
+  const double x = u * (a + b) / (a + std::sqrt((1.0 - u) * a * a + u * b * b));
+  return std::clamp(x, 0.0, 1.0);
+}
+inline double square_to_linear_pdf(double x, double a, double b) { return 2.0 * ((1.0 - x) * a + x * b) / (a + b); }
+inline double linear_to_square(double x, double a, double b) {
+  return std::clamp(x * (a * (2.0 - x) + b * x) / (a + b), 0.0, 1.0);
 }
 
 }  // namespace mcrt
