@@ -157,15 +157,13 @@ inline double angle_minus_sine_ratio(double a, double sn) {
   return (a - sn) / (a * a * a);
 }
 
-// sin and cos of a in [0, pi] (fast_math::sincos_quadrant on the reflected
-// angle beyond pi / 2).
+// sin and cos of a in [0, pi]: fast_math::sincos_quadrant on min(a, pi - a),
+// the cosine's sign that of pi / 2 - a. Without a branch: the angle comes
+// from a uniform sample, so a branch would be mispredicted half the time.
 inline void sincos_half_turn(double a, double& s, double& c) {
-  if (a <= 0.5 * dpi) {
-    fast_math::sincos_quadrant(a, s, c);
-  } else {
-    fast_math::sincos_quadrant(dpi - a, s, c);
-    c = -c;
-  }
+  const double rest = dpi - a;
+  fast_math::sincos_quadrant(std::min(a, rest), s, c);
+  c = std::copysign(c, rest - a);
 }
 
 // 8-point Gauss-Legendre rule on [-1, 1] (nodes +-x, weights w).
@@ -229,12 +227,14 @@ struct projected_cap {
     p.sin_a = sin_a, p.cos_a = cos_a, p.mu = mu, p.cos_b = cos_b;
     if (!(sin_a > 0.0) || !(mu > -1.0) || !(cos_a >= 0.0) || !(cos_b >= 0.0) || !std::isfinite(mu)) return p;
     p.xe = cos_a * cos_b;
-    p.kappa = 1.0 / (1.0 + cos_a) + cos_a * mu * mu / (1.0 + cos_b);
-    p.n0 = 1.0 + cos_a * cos_a * mu * mu;
     if (mu >= 1.0) {
+      // The ellipse alone: its map and inverse need neither the circle
+      // (kappa, n0) nor the tangency point.
       p.type = kind::ellipse;
       p.half_area = 0.5 * dpi * mu;
     } else {
+      p.kappa = 1.0 / (1.0 + cos_a) + cos_a * mu * mu / (1.0 + cos_b);
+      p.n0 = 1.0 + cos_a * cos_a * mu * mu;
       const double am = std::abs(mu);
       const double root = std::sqrt((1.0 - am) * (1.0 + am));  // sqrt(1 - mu^2)
       p.yl = root / cos_b;
@@ -515,47 +515,163 @@ inline dvec2 projected_cap_to_square(const dvec3& d, const projected_cap& pc) {
   return projected_cap_scaled_to_square((d.x - pc.xe) / (sa * sa), d.y / sa, pc);
 }
 
+// Caps wholly above the horizon, the common case, take a short path in mixed
+// precision: what cancels is formed in double from the float inputs (c - o
+// exactly, the height h' = (c - o) . n and the in-plane part p' = |n|^2 (c -
+// o) - h' n, d^2 - r^2), everything else in float: the square roots and
+// reciprocals, the frame, the polar map of the ellipse [UG18 sec. 4.2] and
+// the direction, which is returned in float anyway. A float direction formed
+// from float terms of size <= 1 is within a few ulp (~2e-7 rad) of the exact
+// one, against half an ulp for the double path rounded at the end: the
+// difference is invisible beside the float direction's own resolution
+// (sphere_cone_sampler makes its directions the same way). The density is
+// cos theta / Omega_p with Omega_p = pi sin^2 alpha sin b = pi r^2 h / d^3,
+// no cancellation (h >= r), so it keeps float precision for every cap size.
+//
+// Which caps take it is decided from the double quantities h' and |n|^2
+// alone (projected_cap_above::holds), identically by sample() and pdf().
+struct projected_cap_above {
+  // Whether the cap lies wholly above the horizon: h >= r, i.e. h' >= 0 and
+  // h'^2 >= r^2 |n|^2 (no square root, so nothing rounds before the test).
+  static bool holds(double hn, double nl2, double r2) { return hn >= 0.0 && hn * hn >= r2 * nl2; }
+
+  vec3 ez{0.0f}, ex{0.0f}, ey{0.0f};
+  float sin_a = 0.0f, cos_a = 0.0f, mu = 0.0f, cos_b = 0.0f, xe = 0.0f;
+  float inv_omega = 0.0f;  // d^3 / (pi r^2 h)
+
+  // The density's part: ez and inv_omega. From v = c - o (double, exact),
+  // d2 = |v|^2 > r2, the normal nd (|nd|^2 = nl2 > 0) and hn = v . nd, with
+  // holds(hn, nl2, r2). false if the density overflows a float.
+  bool make_density(double d2, double r2, const dvec3& nd, double nl2, double hn) {
+    const float inv_nl = 1.0f / std::sqrt(float(nl2));
+    const float d2f = float(d2), d = std::sqrt(d2f);
+    ez = vec3(nd) * inv_nl;
+    const float h = float(hn) * inv_nl;
+    inv_omega = d2f * d / (pi * float(r2) * h);
+    return inv_omega > 0.0f && inv_omega <= FLT_MAX;
+  }
+
+  // The rest of the set-up, for sampling: sin alpha, cos alpha, mu, cos b
+  // and the frame (ex along p', ey = ez x ex). After make_density.
+  void make_map(const dvec3& v, double d2, double r, const dvec3& nd, double nl2, double hn) {
+    dvec3 pn = nl2 * v - hn * nd;
+    double pn2 = glm::dot(pn, pn);
+    if (pn2 < 1e-8 * d2 * nl2 * nl2) {
+      // Axis within 1e-4 rad of the normal: p' carries an error of a few ulp
+      // of d along n; one more projection makes it orthogonal again.
+      pn -= (glm::dot(pn, nd) / nl2) * nd;
+      pn2 = glm::dot(pn, pn);
+    }
+    const float inv_d = 1.0f / std::sqrt(float(d2)), rf = float(r);
+    const float pl = std::sqrt(float(pn2));  // |p'| = |n|^2 |p|
+    sin_a = rf * inv_d;
+    cos_a = std::sqrt(float(d2 - r * r)) * inv_d;
+    const float inv_nl = 1.0f / std::sqrt(float(nl2));
+    mu = float(hn) * inv_nl / rf;
+    cos_b = pl * (inv_nl * inv_nl) * inv_d;
+    xe = cos_a * cos_b;
+    if (pl > 0.0f) {
+      ex = vec3(pn) * (1.0f / pl);
+    } else {  // axis along the normal: any x will do (the ellipse is a circle about the origin)
+      const float sign = std::copysign(1.0f, ez.z);
+      const float a = -1.0f / (sign + ez.z), b = ez.x * ez.y * a;
+      ex = vec3(1.0f + sign * ez.x * ez.x * a, sign * b, -sign * ez.x);
+    }
+    ey = glm::cross(ez, ex);
+  }
+
+  // u -> unit direction (world): the polar map of the disk scaled to the
+  // ellipse, the same map as square_to_projected_cap for mu >= 1 (u.x the
+  // radial coordinate r^2, u.y the swept area, lower half first).
+  vec3 sample(vec2 u) const {
+    const float t2 = 2.0f * u.y - 1.0f;  // exact
+    double sn, cs;
+    projected_cap_detail::sincos_half_turn(projected_cap_detail::dpi * std::abs(double(t2)), sn, cs);
+    const float rho = std::sqrt(u.x);
+    const float xd = rho * float(cs), yd = std::copysign(rho * float(sn), t2);
+    const float e = mu * cos_a - cos_b * xd;
+    const float z = sin_a * std::sqrt(e * e + (1.0f - u.x));  // a sum of squares: no cancellation near the horizon
+    const float x = xe + sin_a * sin_a * mu * xd, y = sin_a * yd;
+    return x * ex + y * ey + z * ez;
+  }
+
+  // Density per unit SOLID ANGLE of the unit direction dir in the cap.
+  float density(const vec3& dir) const { return glm::dot(dir, ez) * inv_omega; }
+};
+
 // The receiver's frame and the projected cap of a sphere seen from o with
 // unit normal n, in double: z = n (normalised), x along the part of c - o
 // orthogonal to n. cos alpha and cos b are taken from quantities that do not
 // cancel (d^2 - r^2 of float inputs, the length of the orthogonal part of
 // c - o), sin b = h / d and mu = h / r from the height h = (c - o) . n.
+//
+// The sampler uses it for caps that cross the horizon (projected_cap_above
+// takes the others); projected_solid_angle() and the tests for all. A cap
+// above the horizon gets Omega_p = pi r^2 h / d^3 and, with the frame, the
+// few members its closed-form map needs. The square roots and reciprocals
+// the set-up needs are formed together (fast_math::sqrt4), so they overlap
+// instead of queueing on the divider one after the other.
 struct sphere_projected_view {
   dvec3 v{0.0};  // c - o
-  double d2 = 0.0, d = 0.0, r = 0.0;
+  double d2 = 0.0, d = 0.0, inv_d = 0.0, r = 0.0;
+  double tangent = 0.0;      // sqrt(d^2 - r^2), the distance to the rim
+  double inv_omega = 0.0;    // 1 / cap.omega
   dvec3 ex{1.0, 0.0, 0.0}, ey{0.0, 1.0, 0.0}, ez{0.0, 0.0, 1.0};
   projected_cap cap;
 
   // false (and cap invalid) if o is inside or on the sphere, n is not a
   // direction, or the cap lies wholly below the horizon. with_frame: also
-  // ex, ey (sampling needs them, the pdf does not).
+  // ex, ey and the whole cap (sampling needs them); without, a cap above the
+  // horizon gets only its type, omega and inv_omega (all the density needs).
   bool make(const sphere& sp, const vec3& o, const vec3& n, bool with_frame) {
+    using projected_cap_detail::dpi;
     v = dvec3(sp.center) - dvec3(o);  // exact: a difference of floats in double
     d2 = glm::dot(v, v);
     r = sp.radius;
-    const double r2 = r * r;
+    const double r2 = r * r;  // exact: r is a float
     if (!(d2 > r2) || !(r > 0.0)) return false;
     const dvec3 nd(n);
     const double nl2 = glm::dot(nd, nd);
     if (!(nl2 > 0.0) || !std::isfinite(nl2)) return false;
-    ez = nd / std::sqrt(nl2);
-    const double h = glm::dot(v, ez);
-    if (!(h > -r)) return false;  // wholly below the horizon
-    d = std::sqrt(d2);
-    dvec3 p = v - h * ez;  // the part of c - o in the receiving plane
-    double p2 = glm::dot(p, p);
-    if (p2 < 1e-8 * d2) {
+    // With the normal unnormalised: h' = |n| h and p' = |n|^2 p, p the part of
+    // c - o in the receiving plane, so that every square root and reciprocal
+    // the set-up needs comes from two packed operations issued together.
+    const double hn = glm::dot(v, nd);
+    dvec3 pn = nl2 * v - hn * nd;
+    double pn2 = glm::dot(pn, pn);
+    if (pn2 < 1e-8 * d2 * nl2 * nl2) {
       // Axis within 1e-4 rad of the normal: p carries an error of a few ulp
       // of d along n; one more projection makes it orthogonal again.
-      p -= glm::dot(p, ez) * ez;
-      p2 = glm::dot(p, p);
+      pn -= (glm::dot(pn, nd) / nl2) * nd;
+      pn2 = glm::dot(pn, pn);
     }
-    const double pl = std::sqrt(p2);
-    cap = projected_cap::make(r / d, std::sqrt(d2 - r2) / d, h / r, pl / d);
+    const auto roots = fast_math::sqrt4(nl2, d2, d2 - r2, pn2);            // |n|, d, sqrt(d^2 - r^2), |p'|
+    const auto inv = fast_math::inverse_sqrt4(nl2, d2, r2, pn2 > 0.0 ? pn2 : 1.0);  // their reciprocals, 1 / r
+    d = roots[1], inv_d = inv[1], tangent = roots[2];
+    const double inv_nl = inv[0];
+    ez = nd * inv_nl;
+    const double h = hn * inv_nl;
+    if (!(h > -r)) return false;  // wholly below the horizon
+    if (projected_cap_above::holds(hn, nl2, r2)) {
+      // Wholly above the horizon: Omega_p = pi sin^2 alpha sin b = pi r^2 h / d^3.
+      inv_omega = d2 * d / (dpi * r2 * h);
+      cap = projected_cap{};
+      cap.type = inv_omega > 0.0 && inv_omega <= DBL_MAX ? projected_cap::kind::ellipse : projected_cap::kind::none;
+      cap.omega = 1.0 / inv_omega;
+      if (!with_frame) return cap.valid();
+      // The ellipse's map needs only these (projected_cap::make, mu >= 1).
+      cap.sin_a = r * inv_d, cap.cos_a = tangent * inv_d, cap.mu = h * inv[2];
+      cap.cos_b = roots[3] * inv_nl * inv_nl * inv_d;
+      cap.xe = cap.cos_a * cap.cos_b;
+      cap.half_area = cap.area_scale = 0.5 * dpi * cap.mu;
+    } else {
+      cap = projected_cap::make(r * inv_d, tangent * inv_d, h * inv[2], roots[3] * inv_nl * inv_nl * inv_d);
+      inv_omega = 1.0 / cap.omega;
+    }
     if (!cap.valid()) return false;
     if (with_frame) {
-      if (pl > 0.0) {
-        ex = p / pl;
+      if (pn2 > 0.0) {
+        ex = pn * inv[3];
       } else {  // axis along the normal: any x will do (the ellipse is a circle about the origin)
         const double sign = std::copysign(1.0, ez.z);
         const double a = -1.0 / (sign + ez.z), b = ez.x * ez.y * a;
@@ -596,34 +712,56 @@ struct sphere_projected_solid_angle_sampler {
   }
 
   bool sample(const vec3& o, const vec3& n, vec2 u, light_sample& s) const {
+    const dvec3 v = dvec3(shape.center) - dvec3(o);  // exact: a difference of floats in double
+    const double d2 = glm::dot(v, v), r = shape.radius, r2 = r * r;
+    const dvec3 nd(n);
+    const double nl2 = glm::dot(nd, nd), hn = glm::dot(v, nd);
+    if (d2 > r2 && nl2 > 0.0 && std::isfinite(nl2) && projected_cap_above::holds(hn, nl2, r2)) {
+      projected_cap_above cap;
+      if (!cap.make_density(d2, r2, nd, nl2, hn)) return false;
+      cap.make_map(v, d2, r, nd, nl2, hn);
+      s.dir = cap.sample(u);
+      s.pdf = cap.density(s.dir);
+      if (!(s.pdf > 0.0f) || !(s.pdf <= FLT_MAX)) return false;  // rounded below the horizon / overflow
+      s.dist = float(near_distance(v, d2, r2, dvec3(s.dir)));
+      return true;
+    }
     sphere_projected_view view;
     if (!view.make(shape, o, n, true)) return false;
     const dvec3 l = square_to_projected_cap(u, view.cap);
     s.dir = vec3(l.x * view.ex + l.y * view.ey + l.z * view.ez);
     const dvec3 dir(s.dir);
-    const double p = glm::dot(dir, view.ez) / view.cap.omega;
+    const double p = glm::dot(dir, view.ez) * view.inv_omega;
     if (!(p > 0.0) || !(p <= double(FLT_MAX))) return false;  // rounded below the horizon / overflow
     s.pdf = float(p);
-    s.dist = float(near_distance(view, dir));
+    s.dist = float(near_distance(view.v, view.d2, r2, dir));
     return s.pdf > 0.0f;
   }
 
   // Density per unit SOLID ANGLE at o, receiver normal n, of the unit
-  // direction dir: cos theta / Omega_p on the cap above the horizon. The
-  // cheap tests (horizon, cap) come before the set-up of Omega_p.
+  // direction dir: cos theta / Omega_p on the cap above the horizon.
   float pdf(const vec3& o, const vec3& n, const vec3& dir) const {
+    const dvec3 dd(dir);
+    if (!(glm::dot(dd, dvec3(n)) > 0.0)) return 0.0f;  // below the horizon
     const dvec3 v = dvec3(shape.center) - dvec3(o);
     const double d2 = glm::dot(v, v), r2 = double(shape.radius) * double(shape.radius);
     if (!(d2 > r2)) return 0.0f;
-    const dvec3 dd(dir);
-    if (!(glm::dot(dd, dvec3(n)) > 0.0)) return 0.0f;
-    // In the cap: 1 - cos(angle to the axis) <= 1 - cos alpha, both without cancellation.
+    // In the cap: 1 - cos(angle to the axis) <= 1 - cos alpha = r^2 / (d^2 +
+    // d sqrt(d^2 - r^2)), both without cancellation, multiplied out.
     const double d = std::sqrt(d2);
-    const dvec3 e = dd - v / d;
-    if (!(0.5 * glm::dot(e, e) <= r2 / (d2 + d * std::sqrt(d2 - r2)))) return 0.0f;
+    const dvec3 e = dd - v * (1.0 / d);
+    if (!(0.5 * glm::dot(e, e) * (d2 + d * std::sqrt(d2 - r2)) <= r2)) return 0.0f;
+    const dvec3 nd(n);
+    const double nl2 = glm::dot(nd, nd), hn = glm::dot(v, nd);
+    if (nl2 > 0.0 && std::isfinite(nl2) && projected_cap_above::holds(hn, nl2, r2)) {
+      projected_cap_above cap;
+      if (!cap.make_density(d2, r2, nd, nl2, hn)) return 0.0f;
+      const float p = cap.density(dir);
+      return p > 0.0f && p <= FLT_MAX ? p : 0.0f;
+    }
     sphere_projected_view view;
     if (!view.make(shape, o, n, false)) return 0.0f;
-    const double p = glm::dot(dd, view.ez) / view.cap.omega;
+    const double p = glm::dot(dd, view.ez) * view.inv_omega;
     return p > 0.0 && p <= double(FLT_MAX) ? float(p) : 0.0f;
   }
 
@@ -639,12 +777,11 @@ struct sphere_projected_solid_angle_sampler {
   // sqrt(r^2 - p^2)), b = dir . (c - o), p^2 the squared distance of the
   // centre from the ray: no cancellation near the sphere or far from it. A
   // direction that misses by rounding gets the tangent distance.
-  static double near_distance(const sphere_projected_view& view, const dvec3& dir) {
-    const double b = glm::dot(dir, view.v);
-    const dvec3 perp = view.v - b * dir;
-    const double r2 = view.r * view.r;
+  static double near_distance(const dvec3& v, double d2, double r2, const dvec3& dir) {
+    const double b = glm::dot(dir, v);
+    const dvec3 perp = v - b * dir;
     const double disc = std::max(r2 - glm::dot(perp, perp), 0.0);
-    return (view.d2 - r2) / (b + std::sqrt(disc));
+    return (d2 - r2) / (b + std::sqrt(disc));
   }
 };
 
