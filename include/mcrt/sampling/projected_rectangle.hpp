@@ -113,11 +113,11 @@ class projected_rectangle {
     nd_ = dvec3(n);
     const double nl = glm::length(nd_);
     if (!(nl > 0.0) || !std::isfinite(nl)) return;
-    nd_ /= nl;
+    nd_ *= 1.0 / nl;
     nL_ = {glm::dot(nd_, ex_), glm::dot(nd_, ey_), glm::dot(nd_, ez_)};
     clip();
     if (count_ < 3) return;
-    closed_forms();
+    closed_forms(with_map);
     if (with_map && how_ == method::map) prepare_map();
   }
 
@@ -205,6 +205,10 @@ class projected_rectangle {
     return {dx[i], dy[i]};
   }
   double edge_len(int i) const { return (i & 1) ? l_ : w_; }
+  // The sign of edge i's inward normal (0, h, y0), -(h, 0, x1), -(0, h, y1),
+  // (h, 0, x0) (over its length), and the coordinate of its line.
+  static double edge_sign(int i) { return i == 0 || i == 3 ? 1.0 : -1.0; }
+  double edge_line(int i) const { return i == 0 ? y0_ : i == 1 ? x1_ : i == 2 ? y1_ : x0_; }
 
   // Vertex k in the light plane and the difference of two vertices formed
   // from their corners (exact multiples of w and l) and their offsets.
@@ -261,53 +265,73 @@ class projected_rectangle {
   }
 
   // Step 3: per-edge angles and normals, Lambert, (C), (Z), the choice.
-  void closed_forms() {
+  // Where Lambert's sum is used as is (the common case) the density needs
+  // only the arc angles and m_z; the edge normals (for the map) and the
+  // terms of (C) and (Z) are formed only when needed.
+  void closed_forms(bool with_map) {
     using namespace projected_rectangle_detail;
-    const std::array<double, 4> r = fast_math::sqrt4(h_ * h_ + y0_ * y0_, h_ * h_ + x1_ * x1_, h_ * h_ + y1_ * y1_,
-                                                     h_ * h_ + x0_ * x0_);  // q0, p1, q1, p0: distances of the edge lines
-    double lambert = 0.0, lambert_mag = 0.0, seg = 0.0, seg_mag = 0.0;
+    const double hh = h_ * h_;
+    // q0, p1, q1, p0 (distances of the edge lines) and their reciprocals.
+    const std::array<double, 4> r = fast_math::sqrt4(hh + y0_ * y0_, hh + x1_ * x1_, hh + y1_ * y1_, hh + x0_ * x0_);
+    const std::array<double, 4> ir =
+        fast_math::inverse_sqrt4(hh + y0_ * y0_, hh + x1_ * x1_, hh + y1_ * y1_, hh + x0_ * x0_);
+    double lambert = 0.0, lambert_mag = 0.0;
     bool decentral = false;
+    std::array<double, max_vertices> Ys{}, Xs{}, mzmags{};
     for (int k = 0; k < count_; ++k) {
       const int kn = k + 1 == count_ ? 0 : k + 1;
       const dvec2 a = vertex(k), b = vertex(kn);
       double Y, X, mz, mzmag;
-      dvec3 mL;
       if (kind_[k] == horizon) {
         const dvec2 dv = vertex_difference(k, kn);
         const double cr = a.x * dv.y - a.y * dv.x;
-        Y = std::sqrt(h_ * h_ * glm::dot(dv, dv) + cr * cr);  // |A x B| = |A x (B - A)|
-        X = glm::dot(a, b) + h_ * h_;
+        Y = std::sqrt(hh * glm::dot(dv, dv) + cr * cr);  // |A x B| = |A x (B - A)|
+        X = glm::dot(a, b) + hh;
         mz = 1.0;
         mzmag = 1.0;
-        mL = nL_;
       } else {
         const int e = kind_[k];
-        const double q = r[e];
         const bool along_x = (e & 1) == 0;  // edges 0 and 2 run along x at y = y0, y1
         const double pa = along_x ? a.x : a.y, pb = along_x ? b.x : b.y;
-        Y = seg_[k] * q;
-        X = q * q + pa * pb;
-        // Inward normals (0, h, y0)/q0, -(h, 0, x1)/p1, -(0, h, y1)/q1, (h, 0, x0)/p0.
-        const double sgn = e < 2 ? (e == 0 ? 1.0 : -1.0) : (e == 2 ? -1.0 : 1.0);
-        const double line = e == 0 ? y0_ : e == 1 ? x1_ : e == 2 ? y1_ : x0_;
+        const double line = edge_line(e);
+        Y = seg_[k] * r[e];
+        X = hh + line * line + pa * pb;
+        // m_z of the inward normals (0, h, y0)/q0, -(h, 0, x1)/p1, -(0, h, y1)/q1, (h, 0, x0)/p0.
         const double nh = along_x ? nL_.y : nL_.x;
-        mL = along_x ? dvec3(0.0, sgn * h_ / q, sgn * line / q) : dvec3(sgn * h_ / q, 0.0, sgn * line / q);
-        mz = sgn * (h_ * nh + line * nL_.z) / q;
-        mzmag = (std::abs(h_ * nh) + std::abs(line * nL_.z)) / q;
+        mz = edge_sign(e) * (h_ * nh + line * nL_.z) * ir[e];
+        mzmag = (std::abs(h_ * nh) + std::abs(line * nL_.z)) * ir[e];
       }
-      const double R = std::sqrt(X * X + Y * Y);  // no overflow: |X|, |Y| are squared lengths of the scene, far below 1e150
       const double g = fast_math::atan2_upper(Y, X);
+      Ys[k] = Y, Xs[k] = X, mzmags[k] = mzmag;
       gamma_[k] = g;
-      sin_[k] = Y / R;
-      cos_[k] = X / R;
       mz_[k] = mz;
-      mL_[k] = mL;
       decentral = decentral || mz < 0.0;
       lambert += 0.5 * mz * g;
       lambert_mag += 0.5 * mzmag * g;
-      const double amc = arc_minus_chord(g, sin_[k]);
-      seg += 0.5 * mz * amc;
-      seg_mag += 0.5 * mzmag * amc;
+    }
+    const bool direct = lambert > 0.0 && lambert_mag <= direct_condition * lambert;
+    // The edge normals in the light frame (the map and (Z) need them).
+    if (with_map || !direct) {
+      for (int k = 0; k < count_; ++k) {
+        if (kind_[k] == horizon) {
+          mL_[k] = nL_;
+        } else {
+          const int e = kind_[k];
+          const double sg = edge_sign(e) * ir[e], line = edge_line(e);
+          mL_[k] = (e & 1) == 0 ? dvec3(0.0, sg * h_, sg * line) : dvec3(sg * h_, 0.0, sg * line);
+        }
+      }
+    }
+    double seg = 0.0, seg_mag = 0.0;
+    if (!direct) {
+      for (int k = 0; k < count_; ++k) {
+        const double iR = 1.0 / std::sqrt(Xs[k] * Xs[k] + Ys[k] * Ys[k]);  // no overflow: squared lengths of the scene
+        sin_[k] = Ys[k] * iR;
+        cos_[k] = Xs[k] * iR;
+        const double amc = arc_minus_chord(gamma_[k], sin_[k]);
+        seg += 0.5 * mz_[k] * amc;
+        seg_mag += 0.5 * mzmags[k] * amc;
+      }
     }
     omega_lambert_ = lambert;
     cond_lambert_ = lambert_mag / lambert;
@@ -319,7 +343,7 @@ class projected_rectangle {
       area_ += fan_[k];
     }
     if (!std::isfinite(area_)) area_ = 0.0;
-    if (lambert > 0.0 && cond_lambert_ <= direct_condition) {
+    if (direct) {
       how_ = method::map;
       complement_ = false;
       omega_ = lambert;
