@@ -9,7 +9,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
-#if defined(__AVX__)
+#if defined(__AVX__) || defined(__SSE2__)
 #include <immintrin.h>
 #endif
 
@@ -86,6 +86,27 @@ inline std::array<double, 4> inverse_sqrt4(double a, double b, double c, double 
   _mm256_storeu_pd(y.data(), _mm256_div_pd(_mm256_set1_pd(1.0), _mm256_sqrt_pd(_mm256_set_pd(d, c, b, a))));
 #else
   y = {1.0 / std::sqrt(a), 1.0 / std::sqrt(b), 1.0 / std::sqrt(c), 1.0 / std::sqrt(d)};
+#endif
+  return y;
+}
+
+// The same for four floats (one SSE square root), and four reciprocals of
+// floats (one SSE division).
+inline std::array<float, 4> sqrt4(float a, float b, float c, float d) {
+  std::array<float, 4> y;
+#if defined(__SSE2__)
+  _mm_storeu_ps(y.data(), _mm_sqrt_ps(_mm_set_ps(d, c, b, a)));
+#else
+  y = {std::sqrt(a), std::sqrt(b), std::sqrt(c), std::sqrt(d)};
+#endif
+  return y;
+}
+inline std::array<float, 4> reciprocal4(float a, float b, float c, float d) {
+  std::array<float, 4> y;
+#if defined(__SSE2__)
+  _mm_storeu_ps(y.data(), _mm_div_ps(_mm_set1_ps(1.0f), _mm_set_ps(d, c, b, a)));
+#else
+  y = {1.0f / a, 1.0f / b, 1.0f / c, 1.0f / d};
 #endif
   return y;
 }

@@ -539,45 +539,49 @@ struct projected_cap_above {
   float sin_a = 0.0f, cos_a = 0.0f, mu = 0.0f, cos_b = 0.0f, xe = 0.0f;
   float inv_omega = 0.0f;  // d^3 / (pi r^2 h)
 
-  // The density's part: ez and inv_omega. From v = c - o (double, exact),
-  // d2 = |v|^2 > r2, the normal nd (|nd|^2 = nl2 > 0) and hn = v . nd, with
-  // holds(hn, nl2, r2). false if the density overflows a float.
-  bool make_density(double d2, double r2, const dvec3& nd, double nl2, double hn) {
-    const float inv_nl = 1.0f / std::sqrt(float(nl2));
-    const float d2f = float(d2), d = std::sqrt(d2f);
-    ez = vec3(nd) * inv_nl;
-    const float h = float(hn) * inv_nl;
-    inv_omega = d2f * d / (pi * float(r2) * h);
-    return inv_omega > 0.0f && inv_omega <= FLT_MAX;
-  }
-
-  // The rest of the set-up, for sampling: sin alpha, cos alpha, mu, cos b
-  // and the frame (ex along p', ey = ez x ex). After make_density.
-  void make_map(const dvec3& v, double d2, double r, const dvec3& nd, double nl2, double hn) {
-    dvec3 pn = nl2 * v - hn * nd;
-    double pn2 = glm::dot(pn, pn);
-    if (pn2 < 1e-8 * d2 * nl2 * nl2) {
-      // Axis within 1e-4 rad of the normal: p' carries an error of a few ulp
-      // of d along n; one more projection makes it orthogonal again.
-      pn -= (glm::dot(pn, nd) / nl2) * nd;
+  // From v = c - o (double, exact), d2 = |v|^2 > r2 = r^2, the normal nd
+  // (|nd|^2 = nl2 > 0) and hn = v . nd, with holds(hn, nl2, r2): ez and
+  // inv_omega (the density's part) and, with_map, sin alpha, cos alpha, mu,
+  // cos b and the frame (ex along p', ey = ez x ex). The square roots and
+  // reciprocals come four at a time. false if the density overflows a float.
+  bool make(const dvec3& v, double d2, double r, const dvec3& nd, double nl2, double hn, bool with_map) {
+    const double r2 = r * r;
+    dvec3 pn(0.0);
+    double pn2 = 1.0;
+    if (with_map) {
+      pn = nl2 * v - hn * nd;
       pn2 = glm::dot(pn, pn);
+      if (pn2 < 1e-8 * d2 * nl2 * nl2) {
+        // Axis within 1e-4 rad of the normal: p' carries an error of a few ulp
+        // of d along n; one more projection makes it orthogonal again.
+        pn -= (glm::dot(pn, nd) / nl2) * nd;
+        pn2 = glm::dot(pn, pn);
+      }
     }
-    const float inv_d = 1.0f / std::sqrt(float(d2)), rf = float(r);
-    const float pl = std::sqrt(float(pn2));  // |p'| = |n|^2 |p|
+    // |n|, d, sqrt(d^2 - r^2), |p'| = |n|^2 |p|; then 1 / |n|, 1 / d, 1 / |p'|, |n| / (pi r^2 h') = 1 / (pi r^2 h).
+    const auto roots = fast_math::sqrt4(float(nl2), float(d2), float(d2 - r2), float(pn2));
+    const float pl = roots[3] > 0.0f ? roots[3] : 1.0f;
+    const auto inv = fast_math::reciprocal4(roots[0], roots[1], pl, pi * float(r2 * hn));
+    const float inv_nl = inv[0], d = roots[1], inv_d = inv[1];
+    ez = vec3(nd) * inv_nl;
+    inv_omega = float(d2) * d * roots[0] * inv[3];
+    if (!(inv_omega > 0.0f) || !(inv_omega <= FLT_MAX)) return false;
+    if (!with_map) return true;
+    const float rf = float(r);
     sin_a = rf * inv_d;
-    cos_a = std::sqrt(float(d2 - r * r)) * inv_d;
-    const float inv_nl = 1.0f / std::sqrt(float(nl2));
+    cos_a = roots[2] * inv_d;
     mu = float(hn) * inv_nl / rf;
-    cos_b = pl * (inv_nl * inv_nl) * inv_d;
+    cos_b = roots[3] * (inv_nl * inv_nl) * inv_d;
     xe = cos_a * cos_b;
-    if (pl > 0.0f) {
-      ex = vec3(pn) * (1.0f / pl);
+    if (roots[3] > 0.0f) {
+      ex = vec3(pn) * inv[2];
     } else {  // axis along the normal: any x will do (the ellipse is a circle about the origin)
       const float sign = std::copysign(1.0f, ez.z);
       const float a = -1.0f / (sign + ez.z), b = ez.x * ez.y * a;
       ex = vec3(1.0f + sign * ez.x * ez.x * a, sign * b, -sign * ez.x);
     }
     ey = glm::cross(ez, ex);
+    return true;
   }
 
   // u -> unit direction (world): the polar map of the disk scaled to the
@@ -718,8 +722,7 @@ struct sphere_projected_solid_angle_sampler {
     const double nl2 = glm::dot(nd, nd), hn = glm::dot(v, nd);
     if (d2 > r2 && nl2 > 0.0 && std::isfinite(nl2) && projected_cap_above::holds(hn, nl2, r2)) {
       projected_cap_above cap;
-      if (!cap.make_density(d2, r2, nd, nl2, hn)) return false;
-      cap.make_map(v, d2, r, nd, nl2, hn);
+      if (!cap.make(v, d2, r, nd, nl2, hn, true)) return false;
       s.dir = cap.sample(u);
       s.pdf = cap.density(s.dir);
       if (!(s.pdf > 0.0f) || !(s.pdf <= FLT_MAX)) return false;  // rounded below the horizon / overflow
@@ -755,7 +758,7 @@ struct sphere_projected_solid_angle_sampler {
     const double nl2 = glm::dot(nd, nd), hn = glm::dot(v, nd);
     if (nl2 > 0.0 && std::isfinite(nl2) && projected_cap_above::holds(hn, nl2, r2)) {
       projected_cap_above cap;
-      if (!cap.make_density(d2, r2, nd, nl2, hn)) return 0.0f;
+      if (!cap.make(v, d2, double(shape.radius), nd, nl2, hn, false)) return 0.0f;
       const float p = cap.density(dir);
       return p > 0.0f && p <= FLT_MAX ? p : 0.0f;
     }
