@@ -7,6 +7,7 @@
 //  BM_RectPSA_Exact<normals>   rect_projected_solid_angle_sampler
 //  BM_RectPSA_Bilinear<normals> rect_bilinear_solid_angle_sampler
 //  BM_RectPSA_FloorPeters21<normals> Peters 2021 as published (see below)
+//  BM_RectPSA_FloorPeters21WithPdf<normals> the same, its pdf charged as a second call's
 //
 // Receiver normals: "Up", n = (0, 1, 0) for every observer (a floor under
 // the light: the light is wholly above every horizon, no clipping);
@@ -443,5 +444,42 @@ void BM_RectPSA_FloorPeters21(benchmark::State& state) {
 }
 BENCHMARK(BM_RectPSA_FloorPeters21<normals::up>)->Name("BM_RectPSA_FloorPeters21/Up");
 BENCHMARK(BM_RectPSA_FloorPeters21<normals::random>)->Name("BM_RectPSA_FloorPeters21/Random");
+
+// The same with the pdf of the sampled direction charged as a second call
+// from the same receiver would pay it, as the library's pdf() does: the
+// clip and the polygon's set-up again (its projected solid angle), then
+// cos / Omega_proj. Not the published usage (a shader prepares once per
+// shading point and reuses the set-up for the light sample and the BSDF
+// direction's pdf), but the like-for-like counterpart of sample() + pdf()
+// through a stateless interface.
+template <normals N>
+void BM_RectPSA_FloorPeters21WithPdf(benchmark::State& state) {
+  const rect light = bench::cornell_rect_light();
+  const std::vector<vec3> obs = bench::observers_around(light);
+  const std::vector<vec3> ns = receiver_normals(light, obs, N);
+  pcg32 rng(1, 2);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const std::size_t k = i++ & (obs.size() - 1);
+    const peters21::frame f(ns[k]);
+    vec3 v[peters21::max_vertices];
+    const int count = peters21::clip(light, obs[k], f, v);
+    if (count == 0) continue;
+    const peters21::polygon p = peters21::prepare(count, v);
+    const vec3 local = peters21::sample(p, rng.uniform2());
+    const vec3 dir = f.to_world(local);
+    benchmark::DoNotOptimize(dir);
+    const peters21::frame f2(ns[k]);
+    vec3 v2[peters21::max_vertices];
+    const int count2 = peters21::clip(light, obs[k], f2, v2);
+    if (count2 == 0) continue;
+    const peters21::polygon p2 = peters21::prepare(count2, v2);
+    const float pdf = glm::dot(dir, ns[k]) / p2.psa;
+    benchmark::DoNotOptimize(pdf);
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_RectPSA_FloorPeters21WithPdf<normals::up>)->Name("BM_RectPSA_FloorPeters21WithPdf/Up");
+BENCHMARK(BM_RectPSA_FloorPeters21WithPdf<normals::random>)->Name("BM_RectPSA_FloorPeters21WithPdf/Random");
 
 }  // namespace
