@@ -726,7 +726,7 @@ struct sphere_projected_solid_angle_sampler {
       s.dir = cap.sample(u);
       s.pdf = cap.density(s.dir);
       if (!(s.pdf > 0.0f) || !(s.pdf <= FLT_MAX)) return false;  // rounded below the horizon / overflow
-      s.dist = float(near_distance(v, d2, r2, dvec3(s.dir)));
+      s.dist = near_distance(v, d2, r2, dvec3(s.dir));
       return true;
     }
     sphere_projected_view view;
@@ -737,7 +737,7 @@ struct sphere_projected_solid_angle_sampler {
     const double p = glm::dot(dir, view.ez) * view.inv_omega;
     if (!(p > 0.0) || !(p <= double(FLT_MAX))) return false;  // rounded below the horizon / overflow
     s.pdf = float(p);
-    s.dist = float(near_distance(view.v, view.d2, r2, dir));
+    s.dist = near_distance(view.v, view.d2, r2, dir);
     return s.pdf > 0.0f;
   }
 
@@ -779,12 +779,15 @@ struct sphere_projected_solid_angle_sampler {
   // Distance along the unit dir to the near intersection, (d^2 - r^2) / (b +
   // sqrt(r^2 - p^2)), b = dir . (c - o), p^2 the squared distance of the
   // centre from the ray: no cancellation near the sphere or far from it. A
-  // direction that misses by rounding gets the tangent distance.
-  static double near_distance(const dvec3& v, double d2, double r2, const dvec3& dir) {
+  // direction that misses by rounding gets the tangent distance. The terms
+  // in double, the last square root and division in float: the distance is
+  // returned as a float, and both are well conditioned (a sum of positive
+  // terms, a quotient).
+  static float near_distance(const dvec3& v, double d2, double r2, const dvec3& dir) {
     const double b = glm::dot(dir, v);
     const dvec3 perp = v - b * dir;
     const double disc = std::max(r2 - glm::dot(perp, perp), 0.0);
-    return (d2 - r2) / (b + std::sqrt(disc));
+    return float(d2 - r2) / (float(b) + std::sqrt(float(disc)));
   }
 };
 
