@@ -1,4 +1,5 @@
 // The mcrt executable: `mcrt render`, `mcrt diff` and `mcrt samples` (shared/spec cli.md).
+#include <cmath>
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -23,6 +24,7 @@ struct render_options {
   std::string integrator = "mixture", sampler = "sobol", mis_heuristic = "power", light_select = "power";
   std::optional<int> spp, width, height, max_depth, rr_depth;
   std::optional<unsigned> threads;
+  std::optional<float> auto_rest_cost, auto_rest_variance;
   std::uint64_t seed = 0;
   bool quiet = false;
 };
@@ -69,7 +71,18 @@ int run_render(const render_options& opt) {
   const std::optional<light_sampling> strategy = parse_light_sampling_flag(opt.light_sampling);
 
   const cli::ellipse_map map = opt.ellipse_map == "polar" ? cli::ellipse_map::polar : cli::ellipse_map::parallel;
-  loaded_scene ls = load_scene(opt.scene, strategy, map);
+  auto_params ap;
+  if (opt.auto_rest_cost) {
+    if (!(*opt.auto_rest_cost >= 0.0f) || !std::isfinite(*opt.auto_rest_cost))
+      throw input_error("--auto-rest-cost: must be a finite number >= 0");
+    ap.rest_cost = *opt.auto_rest_cost;
+  }
+  if (opt.auto_rest_variance) {
+    if (!(*opt.auto_rest_variance > 0.0f) || !std::isfinite(*opt.auto_rest_variance))
+      throw input_error("--auto-rest-variance: must be a finite number > 0");
+    ap.rest_variance = *opt.auto_rest_variance;
+  }
+  loaded_scene ls = load_scene(opt.scene, strategy, map, ap);
   const std::string output = opt.output.empty() ? ls.name + ".exr" : opt.output;
   check_writable(output, true);
   if (!opt.stats.empty()) check_writable(opt.stats, false);
@@ -187,6 +200,10 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--light-sampling", ro.light_sampling, "Sample every light by area, solid-angle, projected-solid-angle (cosine-aware) or "
                          "bilinear-solid-angle (comparison: bilinear cosine pre-warp)")
       ->check(CLI::IsMember({"area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle", "auto"}));
+  render_cmd->add_option("--auto-rest-cost", ro.auto_rest_cost,
+                         "--light-sampling auto: the rest of the path's time per light sample, ns (default 265)");
+  render_cmd->add_option("--auto-rest-variance", ro.auto_rest_variance,
+                         "--light-sampling auto: the relative variance the rest of the path adds (default 0.25)");
   render_cmd->add_option("--ellipse-map", ro.ellipse_map,
                          "Map of the spherical ellipse for ellipses sampled by solid angle (default parallel)")
       ->check(CLI::IsMember({"parallel", "polar"}));

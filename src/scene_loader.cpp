@@ -208,16 +208,18 @@ std::pair<float, float> interval(const reader& rd, const json& o, const std::str
 // without the named strategy keeps the closest one it has: a sphere asked
 // for bilinear-solid-angle (a pre-warp of a planar light's map) gets its
 // exact projected-solid-angle map, which that pre-warp approximates.
-void add_light(scene& world, const rect& s, std::uint32_t mat, std::optional<light_sampling> strategy, ellipse_map) {
+void add_light(scene& world, const rect& s, std::uint32_t mat, std::optional<light_sampling> strategy, ellipse_map,
+               const auto_params& ap) {
   switch (strategy.value_or(light_sampling::area)) {
     case light_sampling::area: world.add_light(rect_area_sampler{s}, mat); return;
     case light_sampling::solid_angle: world.add_light(rect_solid_angle_sampler{s}, mat); return;
     case light_sampling::projected_solid_angle: world.add_light(rect_projected_solid_angle_sampler{s}, mat); return;
     case light_sampling::bilinear_solid_angle: world.add_light(rect_bilinear_solid_angle_sampler{s}, mat); return;
+    case light_sampling::automatic: world.add_light(rect_auto_sampler{s, ap}, mat); return;
   }
 }
 void add_light(scene& world, const ellipse& s, std::uint32_t mat, std::optional<light_sampling> strategy,
-               ellipse_map map) {
+               ellipse_map map, const auto_params& ap) {
   switch (strategy.value_or(light_sampling::area)) {
     case light_sampling::area: world.add_light(ellipse_area_sampler{s}, mat); return;
     case light_sampling::solid_angle:
@@ -228,22 +230,25 @@ void add_light(scene& world, const ellipse& s, std::uint32_t mat, std::optional<
       return;
     case light_sampling::projected_solid_angle: world.add_light(ellipse_projected_solid_angle_sampler{s}, mat); return;
     case light_sampling::bilinear_solid_angle: world.add_light(ellipse_bilinear_solid_angle_sampler{s}, mat); return;
+    case light_sampling::automatic: world.add_light(ellipse_auto_sampler{s, ap}, mat); return;
   }
 }
-void add_light(scene& world, const sphere& s, std::uint32_t mat, std::optional<light_sampling> strategy, ellipse_map) {
+void add_light(scene& world, const sphere& s, std::uint32_t mat, std::optional<light_sampling> strategy, ellipse_map,
+               const auto_params& ap) {
   switch (strategy.value_or(light_sampling::solid_angle)) {
     case light_sampling::area: world.add_light(sphere_area_sampler{s}, mat); return;
     case light_sampling::solid_angle: world.add_light(sphere_cone_sampler{s}, mat); return;
     case light_sampling::projected_solid_angle:
     case light_sampling::bilinear_solid_angle: world.add_light(sphere_projected_solid_angle_sampler{s}, mat); return;
+    case light_sampling::automatic: world.add_light(sphere_auto_sampler{s, ap}, mat); return;
   }
 }
 
 // A strategy's name in a scene file or on the command line; nullopt for a
-// name that is not a strategy ("auto" included: see parse_light_sampling_flag).
+// name that is not a strategy.
 std::optional<light_sampling> strategy_named(const std::string& value) {
   for (const light_sampling s : {light_sampling::area, light_sampling::solid_angle, light_sampling::projected_solid_angle,
-                                 light_sampling::bilinear_solid_angle})
+                                 light_sampling::bilinear_solid_angle, light_sampling::automatic})
     if (value == to_string(s)) return s;
   return std::nullopt;
 }
@@ -251,7 +256,7 @@ constexpr const char* strategy_names = "area, solid-angle, projected-solid-angle
 
 void read_object(const reader& rd, const json& o, const std::string& path, scene& world,
                  const std::map<std::string, std::uint32_t>& material_ids,
-                 std::optional<light_sampling> override_strategy, ellipse_map map) {
+                 std::optional<light_sampling> override_strategy, ellipse_map map, const auto_params& ap) {
   if (!o.is_object()) rd.ctx.fail(path, std::string("expected an object, got ") + type_name(o));
   std::string type = rd.string(o, path, "type");
   const std::string mat_name = rd.string(o, path, "material");
@@ -277,9 +282,6 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
     if (!sampled) rd.ctx.fail(place, "only a light or a sampled object (\"sample\": true) has a sampling strategy");
     const std::string value = rd.string(o, path, "sampling");
     const std::optional<light_sampling> chosen = strategy_named(value);
-    if (value == "auto")
-      rd.ctx.fail(place, "'auto' is not available in this build (available: area, solid-angle, projected-solid-angle, "
-                         "bilinear-solid-angle)");
     if (!chosen) rd.ctx.fail(place, "unknown strategy '" + value + "' (expected " + strategy_names + ")");
     if (typed_sa && *chosen != light_sampling::solid_angle)
       rd.ctx.fail(place, "'" + value + "' contradicts the type '" + type + "_sa' (sampled by solid angle)");
@@ -292,7 +294,7 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
 
   auto add = [&](const auto& shape) {
     if (sampled)
-      add_light(world, shape, mat, strategy, map);
+      add_light(world, shape, mat, strategy, map, ap);
     else
       world.add(shape, mat);
   };
@@ -342,13 +344,11 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
 std::optional<light_sampling> parse_light_sampling_flag(const std::string& value) {
   if (value.empty()) return std::nullopt;
   if (const auto s = strategy_named(value)) return s;
-  if (value == "auto")
-    throw input_error("--light-sampling: 'auto' is not available in this build (available: area, solid-angle, "
-                      "projected-solid-angle, bilinear-solid-angle)");
   throw input_error("--light-sampling: unknown strategy '" + value + "' (expected " + strategy_names + ")");
 }
 
-loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy, ellipse_map map) {
+loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy, ellipse_map map,
+                        const auto_params& ap) {
   const context ctx{path};
   const reader rd{ctx};
   std::ifstream in(path, std::ios::binary);
@@ -400,7 +400,7 @@ loaded_scene load_scene(const std::string& path, std::optional<light_sampling> o
   if (!objs.is_array()) ctx.fail("objects", std::string("expected an array, got ") + type_name(objs));
   if (objs.empty()) ctx.fail("objects", "the scene has no objects");
   for (std::size_t i = 0; i < objs.size(); ++i)
-    read_object(rd, objs[i], "objects[" + std::to_string(i) + "]", out.world, ids, override_strategy, map);
+    read_object(rd, objs[i], "objects[" + std::to_string(i) + "]", out.world, ids, override_strategy, map, ap);
 
   // Self-intersection guard proportional to the scene's coordinates: a few
   // thousand float ulps of the largest coordinate (1.1e-3 for the 555-unit

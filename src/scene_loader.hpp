@@ -45,7 +45,9 @@ std::optional<light_sampling> parse_light_sampling_flag(const std::string& value
 // override_strategy: --light-sampling; switches every light (emitter) to one
 // strategy; non-emitting sampled objects keep their own.
 // map: --ellipse-map; the map of every ellipse sampled by solid angle.
+// ap: the parameters of every light sampled by `auto` (--auto-rest-cost,
+// --auto-rest-variance).
 loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy = std::nullopt,
-                        ellipse_map map = ellipse_map::parallel);
+                        ellipse_map map = ellipse_map::parallel, const auto_params& ap = {});
 
 }  // namespace mcrt::cli

@@ -302,7 +302,7 @@ TEST_F(Cli, PerLightSamplingField) {
   ASSERT_EQ(run("render " + s.string() + " -o " + out.string() + " --light-sampling area --stats " + stats.string() + " --quiet").status, 0);
   EXPECT_EQ(nlohmann::json::parse(slurp(stats))["light_sampling"], "area");
   expect_bad_scene(scene_with(floor + ", " + lamp + R"(, "sampling": "sideways"})"), {"objects[1].sampling", "sideways"});
-  for (const char* strategy : {"projected-solid-angle", "bilinear-solid-angle"}) {
+  for (const char* strategy : {"projected-solid-angle", "bilinear-solid-angle", "auto"}) {
     const fs::path c = write("lamp_c.json", scene_with(floor + ", " + lamp + R"(, "sampling": ")" + strategy + R"("})"));
     ASSERT_EQ(run("render " + c.string() + " -o " + out.string() + " --stats " + stats.string() + " --quiet").status, 0) << strategy;
     EXPECT_EQ(nlohmann::json::parse(slurp(stats))["light_sampling"], strategy);
@@ -311,19 +311,18 @@ TEST_F(Cli, PerLightSamplingField) {
   const std::string ball = R"({"type": "sphere", "center": [0, 2, 0], "radius": 0.5, "material": "light")";
   for (const auto& [field, used] : {std::pair{"", "solid-angle"}, {R"(, "sampling": "area")", "area"},
                                     {R"(, "sampling": "projected-solid-angle")", "projected-solid-angle"},
-                                    {R"(, "sampling": "bilinear-solid-angle")", "projected-solid-angle"}}) {
+                                    {R"(, "sampling": "bilinear-solid-angle")", "projected-solid-angle"},
+                                    {R"(, "sampling": "auto")", "auto"}}) {
     const fs::path b = write("ball.json", scene_with(floor + ", " + ball + field + "}"));
     ASSERT_EQ(run("render " + b.string() + " -o " + out.string() + " --stats " + stats.string() + " --quiet").status, 0) << field;
     EXPECT_EQ(nlohmann::json::parse(slurp(stats))["light_sampling"], used) << field;
   }
-  expect_bad_scene(scene_with(floor + ", " + lamp + R"(, "sampling": "auto"})"),
-                   {"objects[1].sampling", "not available in this build"});
   expect_bad_scene(scene_with(floor + R"(, {"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "white", "sampling": "area"})"),
                    {"objects[1].sampling", "only a light"});
   expect_bad_scene(scene_with(floor + R"(, {"type": "xz_rect_sa", "x0": -1, "x1": 1, "z0": -1, "z1": 1, "k": 2, "material": "light", "sampling": "area"})"),
                    {"objects[1].sampling", "contradicts"});
-  const fs::path out2 = dir / "o2.exr";
-  expect_bad("render " + s.string() + " -o " + out2.string() + " --quiet --light-sampling auto", {"--light-sampling", "not available"}, out2);
+  ASSERT_EQ(run("render " + s.string() + " -o " + out.string() + " --light-sampling auto --stats " + stats.string() + " --quiet").status, 0);
+  EXPECT_EQ(nlohmann::json::parse(slurp(stats))["light_sampling"], "auto");
 }
 
 // mcrt samples: the CSV of the contract, to a file or to stdout; samples on
@@ -332,7 +331,7 @@ TEST_F(Cli, PerLightSamplingField) {
 TEST_F(Cli, SamplesWritesTheContractsCsv) {
   const fs::path scene = fs::path(MCRT_SCENES_DIR) / "cornell_rect.json", out = dir / "s.csv";
   const std::string base = "samples " + scene.string() + " --light 0 --from 278,1,279 --normal 0,1,0 ";
-  for (const char* strategy : {"area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle"}) {
+  for (const char* strategy : {"area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle", "auto"}) {
     ASSERT_EQ(run(base + "--n 2000 --seed 4 --light-sampling " + strategy + " -o " + out.string()).status, 0);
     std::istringstream csv(slurp(out));
     std::string line;
@@ -385,7 +384,7 @@ TEST_F(Cli, EveryShippedSceneRenders) {
   for (const auto& e : fs::directory_iterator(MCRT_SCENES_DIR)) {
     if (e.path().extension() != ".json") continue;
     // Each integrator with another sample generator.
-    for (const char* strategy : {"area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle"})
+    for (const char* strategy : {"area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle", "auto"})
       for (const auto& [integrator, sampler] : {std::pair{"mixture", "independent"}, {"nee", "stratified"}, {"mis", "sobol"}}) {
       const fs::path out = dir / (e.path().stem().string() + ".exr"), stats = dir / "s.json";
       const result r = run("render " + e.path().string() + " -o " + out.string() + " --width 24 --height 24 --spp 2 --light-sampling " +

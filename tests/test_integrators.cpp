@@ -290,6 +290,13 @@ TEST(Integrators, AgreeInMeanWithCosineAwareStrategies) {
   for (const char* name : {"cornell_rect", "cornell_disk_large"})
     expect_scene_agrees(name, light_sampling::bilinear_solid_angle);
 }
+
+// `auto` (a strategy chosen per light and shading point) on a rectangle, a
+// sphere and the two-light scene, where it mixes strategies within a path.
+TEST(Integrators, AgreeInMeanWithAuto) {
+  for (const char* name : {"cornell_rect", "cornell_sphere", "cornell_two_lights"})
+    expect_scene_agrees(name, light_sampling::automatic);
+}
 #endif
 
 // Direct light only under next-event estimation on the unoccluded floor

@@ -115,6 +115,8 @@ void add_rect_light(scene& sc, const rect& r, const std::string& strategy) {
     sc.add_light(rect_projected_solid_angle_sampler{r}, 1);
   else if (strategy == "bilinear-solid-angle")
     sc.add_light(rect_bilinear_solid_angle_sampler{r}, 1);
+  else if (strategy == "auto")
+    sc.add_light(rect_auto_sampler{r}, 1);
   else
     FAIL() << "no rectangle strategy " << strategy;
 }
@@ -129,6 +131,8 @@ void add_disk_light(scene& sc, const ellipse& e, const std::string& strategy) {
     sc.add_light(ellipse_projected_solid_angle_sampler{e}, 1);
   else if (strategy == "bilinear-solid-angle")
     sc.add_light(ellipse_bilinear_solid_angle_sampler{e}, 1);
+  else if (strategy == "auto")
+    sc.add_light(ellipse_auto_sampler{e}, 1);
   else
     FAIL() << "no ellipse strategy " << strategy;
 }
@@ -139,6 +143,8 @@ void add_sphere_light(scene& sc, const sphere& sp, const std::string& strategy) 
     sc.add_light(sphere_cone_sampler{sp}, 1);
   else if (strategy == "projected-solid-angle")
     sc.add_light(sphere_projected_solid_angle_sampler{sp}, 1);
+  else if (strategy == "auto")
+    sc.add_light(sphere_auto_sampler{sp}, 1);
   else
     FAIL() << "no sphere strategy " << strategy;
 }
@@ -208,16 +214,16 @@ TEST_P(FloorUnderSphere, MatchesTheProjectedCap) {
 INSTANTIATE_TEST_SUITE_P(All, FloorUnderRect,
                          ::testing::Combine(integrators, samplers,
                                             ::testing::Values("area", "solid-angle", "projected-solid-angle",
-                                                              "bilinear-solid-angle")),
+                                                              "bilinear-solid-angle", "auto")),
                          combo_name);
 INSTANTIATE_TEST_SUITE_P(All, FloorUnderDisk,
                          ::testing::Combine(integrators, samplers,
                                             ::testing::Values("area", "solid-angle", "polar", "projected-solid-angle",
-                                                              "bilinear-solid-angle")),
+                                                              "bilinear-solid-angle", "auto")),
                          combo_name);
 INSTANTIATE_TEST_SUITE_P(All, FloorUnderSphere,
                          ::testing::Combine(integrators, samplers,
-                                            ::testing::Values("area", "solid-angle", "projected-solid-angle")),
+                                            ::testing::Values("area", "solid-angle", "projected-solid-angle", "auto")),
                          combo_name);
 
 // The vanishing variance: under next-event estimation of direct light alone

@@ -7,6 +7,7 @@
 #include <variant>
 
 #include "mcrt/core/dispatch.hpp"
+#include "mcrt/sampling/auto_strategy.hpp"
 #include "mcrt/sampling/bilinear_spherical_ellipse.hpp"
 #include "mcrt/sampling/bilinear_spherical_rectangle.hpp"
 #include "mcrt/sampling/ellipse_area.hpp"
@@ -30,7 +31,8 @@ using light = std::variant<rect_area_sampler, rect_solid_angle_sampler, ellipse_
                            ellipse_solid_angle_sampler, ellipse_polar_solid_angle_sampler, sphere_cone_sampler,
                            rect_projected_solid_angle_sampler, sphere_projected_solid_angle_sampler,
                            ellipse_projected_solid_angle_sampler, sphere_area_sampler,
-                           rect_bilinear_solid_angle_sampler, ellipse_bilinear_solid_angle_sampler>;
+                           rect_bilinear_solid_angle_sampler, ellipse_bilinear_solid_angle_sampler,
+                           rect_auto_sampler, ellipse_auto_sampler, sphere_auto_sampler>;
 
 // The strategy a light-sampling class implements (--stats, mcrt samples).
 template <class S>
@@ -45,6 +47,9 @@ constexpr light_sampling strategy_of() {
   else if constexpr (std::is_same_v<S, rect_bilinear_solid_angle_sampler> ||
                      std::is_same_v<S, ellipse_bilinear_solid_angle_sampler>)
     return light_sampling::bilinear_solid_angle;
+  else if constexpr (std::is_same_v<S, rect_auto_sampler> || std::is_same_v<S, ellipse_auto_sampler> ||
+                     std::is_same_v<S, sphere_auto_sampler>)
+    return light_sampling::automatic;
   else
     return light_sampling::solid_angle;
 }

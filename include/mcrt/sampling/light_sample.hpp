@@ -47,7 +47,9 @@ struct light_sample {
 //                         approximation of cos theta on its unit square
 //                         (Hart et al. 2020, as pbrt-v4), a comparison
 //                         strategy for rectangles and ellipses.
-enum class light_sampling { area, solid_angle, projected_solid_angle, bilinear_solid_angle };
+// automatic: `auto`, one of the first three chosen per light and shading
+// point (auto_strategy.hpp).
+enum class light_sampling { area, solid_angle, projected_solid_angle, bilinear_solid_angle, automatic };
 
 // The command line's and the scene format's name of a strategy.
 constexpr std::string_view to_string(light_sampling s) {
@@ -56,6 +58,7 @@ constexpr std::string_view to_string(light_sampling s) {
     case light_sampling::solid_angle: return "solid-angle";
     case light_sampling::projected_solid_angle: return "projected-solid-angle";
     case light_sampling::bilinear_solid_angle: return "bilinear-solid-angle";
+    case light_sampling::automatic: return "auto";
   }
   return "?";
 }
