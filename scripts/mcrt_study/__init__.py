@@ -1,0 +1,136 @@
+"""Error against run time of the renderer's configurations.
+
+Runs the whole study with one command: for every Cornell scene, every
+configuration of the renderer — light-sampling strategy (``area``,
+``solid-angle``) × integrator (``mixture``: Shirley's mixture pdf, ``nee``:
+next-event estimation, ``mis``: NEE with multiple importance sampling) ×
+sample generator (``independent``, ``stratified``, ``sobol``) — and both
+light-transport modes (``global``: the scene's max depth; ``direct``: max
+depth 1), it renders a sweep of sample counts with several seeds, measures the
+render time (``render_seconds`` from ``mcrt render --stats``: the rendering
+alone, no process start, no I/O) and the error against a reference image
+(``rmse``, ``mse``, ``relmse`` from ``mcrt diff --json``), then writes a CSV,
+markdown tables, plots and a report.
+
+Usage (from the repository root, with the virtual environment made by
+scripts/setup.sh)::
+
+    .venv/bin/python scripts/study.py                 # full study -> bench/results/
+    .venv/bin/python scripts/study.py --quick         # a few minutes -> build/study-quick/
+    .venv/bin/python scripts/study.py --quick --check # and verify the outputs
+
+    # choose what to run: every axis has its option
+    .venv/bin/python scripts/study.py --scenes cornell_rect cornell_disk \\
+        --strategies area solid-angle --integrators mixture mis \\
+        --samplers independent sobol --depths global direct \\
+        --spp 4 16 64 --seeds 1 2 3 --ref-spp 4096 --width 300 --height 300 \\
+        --threads 2 --mcrt build/mcrt --out /tmp/study
+
+Defaults (the full study): scenes cornell_rect, cornell_rect_large,
+cornell_disk, cornell_disk_large (add cornell_materials with --scenes); both
+strategies, all three integrators, all three samplers, both depth modes
+(36 configurations and modes per scene, 144 over the four scenes); spp 8,
+32, 128; seeds 1, 2, 3 (9 renders per configuration and mode: 1296 renders and
+as many diffs); half the scenes' width and height (300x300 for the Cornell
+scenes' 600x600: the same samples per pixel at a quarter of the cost;
+``--width 600 --height 600`` for their own); the scenes' max depth
+(``--max-depth`` overrides it for the global mode); a 4096 spp reference per
+scene and depth mode (8 in all) rendered with seed 7919; all hardware threads.
+About an hour on a 2-core machine that is otherwise idle (renders ~25 min,
+references ~20 min, mcrt process start-up and image I/O ~10 min).
+``--quick``: 48x48, spp 4, 8, 16, 32, one seed, integrators mixture and mis,
+samplers independent and sobol, both depth modes, 1024 spp references, output
+in build/study-quick (ignored by git); each of these can still be overridden.
+
+Reference images. One reference per scene and depth mode (max depth), shared
+by every strategy, integrator and sampler since they all converge to the same
+image, rendered by the reference configuration: ``--ref-integrator`` (default
+mis), ``--ref-sampler`` (default sobol) and ``--ref-strategy`` (default:
+solid-angle when the mcrt binary supports it for that scene, else area) at
+``--ref-spp``. References are cached in OUT/references/ under a key made of the
+scene file's content, the resolution, spp, max depth, seed, strategy,
+integrator and sampler (``--ref-key-binary`` adds a hash of the mcrt binary),
+so they are rendered once; a reference made by mixture + independent has the
+key of the earlier, single-integrator study, whose cache stays valid.
+
+Resuming. Every finished point is appended to OUT/results.csv at once; a run
+skips the points already there (a point is scene, strategy, integrator,
+sampler, max depth, spp, seed). OUT/study_state.json remembers, per scene and
+max depth, the settings the points were made with (scene content, resolution,
+max depth, reference): when those change, the points of that scene and depth
+are dropped and run again. ``--fresh`` discards all previous points
+(references stay cached). A results.csv of the earlier format
+(scene,strategy,spp,seed,seconds,rmse,mse,relmse) is read as integrator
+mixture, sampler independent and the scene's max depth (how it was made) and
+rewritten in the new format; a study_state.json of the earlier version is
+carried over likewise.
+
+Sweep order. For every seed and spp, every depth mode and configuration is
+rendered in turn (the order of the configurations rotated from one point to
+the next), so that a drift of the machine's speed affects all configurations
+alike.
+
+Unavailable strategies. A configuration that mcrt rejects as "not available
+in this build" (exit status 2) is skipped for that scene and named in the
+report; the study goes on, and picks it up unchanged once mcrt supports it (a
+reference that fell back to area sampling is then rendered again with
+solid-angle sampling, and the points of its scene and depth with it). Any
+other mcrt failure is reported too and makes the exit status 1.
+
+Progress is shown on stderr as a plain-text bar with an estimate of the time
+left. ``--report-only`` rebuilds tables, plots and report from the CSV
+without rendering (without --spp or --seeds, for the spp values and seeds the
+CSV holds). ``python scripts/study.py --help`` lists every option.
+
+Analysis. The efficiency of a render is 1/(MSE × seconds); a configuration's
+efficiency is the geometric mean of its renders' efficiencies over every spp
+and seed of the sweep, compared with the baseline (area, mixture, independent)
+of the same scene and depth mode. The tables give, per scene and depth mode,
+the efficiency of every configuration and its ratio to the baseline (the best
+marked), the MSE of every configuration interpolated at a few equal time
+budgets, and the log-log slope of RMSE against spp (−0.5 for Monte Carlo;
+steeper for a quasi-Monte-Carlo sampler where the integrand is smooth enough,
+e.g. direct lighting). The earlier area-vs-solid-angle tables and plots are
+kept for the slice integrator mixture, sampler independent, global depth (or
+the first selected integrator, sampler and mode when those are not run).
+
+Outputs (in OUT):
+    results.csv          scene,strategy,integrator,sampler,max_depth,spp,seed,
+                         seconds,rmse,mse,relmse (max_depth: the value passed
+                         to mcrt, 1 in the direct mode)
+    tables.md            the markdown tables
+    README.md            the report: machine, commit, command line, date,
+                         tables, sampler costs and the plots
+    efficiency_global.png, efficiency_direct.png  (efficiency per configuration
+                         and scene, grouped bars, log scale)
+    rmse_vs_spp.png, time_vs_spp.png, rmse_vs_time.png, efficiency.png,
+    rmse_diff_SCENE.png  (the area-vs-solid-angle slice; RMSE area - RMSE
+                         solid-angle per spp)
+    samplers.json        raw output of mcrt_bench_samplers
+    references/          cached reference images (EXR) and their metadata
+
+``--check`` verifies the outputs afterwards (files exist, CSV columns, every
+configuration has its points in every scene and depth mode, RMSE decreasing
+with spp: negative log-log slope per scene, depth mode and configuration,
+efficiency tables and plots present) and exits 1 when a check fails; the test
+suite runs ``--quick --check``.
+
+Code (this package; scripts/study.py is the command's entry point and calls
+cli.main):
+    config.py       constants, the types (Config, SceneInfo, Settings, ...),
+                    the command line and its defaults
+    scenes.py       scene files by name or path
+    mcrt.py         running mcrt: render (with its time), diff
+    references.py   reference images and their cache keys
+    results.py      results.csv and study_state.json (resuming)
+    runner.py       the sweep, and the sampler benchmark
+    analysis.py     efficiency, standard errors, equal-time interpolation,
+                    convergence slopes, crossovers (pure; no files)
+    report.py       markdown tables and README.md
+    plots.py        the figures (matplotlib)
+    check.py        --check
+    cli.py          main()
+    util.py         hashes, atomic writes, logging, the progress bar
+    tests/          unit tests of the analysis on synthetic data:
+                    .venv/bin/python -m unittest discover -s scripts/mcrt_study/tests -t scripts
+"""

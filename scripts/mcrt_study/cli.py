@@ -1,0 +1,85 @@
+"""The command: run the study, or rebuild its report, then optionally check it."""
+
+from __future__ import annotations
+
+import datetime
+import signal
+import sys
+import time
+
+from .analysis import scene_panels, select_rows, slice_rows
+from .check import run_checks
+from .config import (
+    Config, Failure, REPORT_MD, RESULTS_CSV, STATE_JSON, SceneInfo, Settings, build_parser,
+    resolve_settings,
+)
+from .plots import make_efficiency_plots, make_slice_plots
+from .report import build_tables, write_report
+from .results import legacy_max_depths, read_csv, read_state
+from .runner import run_sampler_bench, run_study
+from .scenes import load_scene
+from .util import format_duration, log
+
+
+def report_only_inputs(settings: Settings, scenes: list[SceneInfo], spp_given: bool,
+                       seeds_given: bool) -> list[dict]:
+    """For --report-only: the CSV's rows and the failures recorded in the state file.
+
+    Without --spp or --seeds, the report covers the spp values and seeds the
+    CSV holds for the selected scenes (so an earlier run's report can be
+    rebuilt without repeating its sweep options).
+    """
+    settings.out.mkdir(parents=True, exist_ok=True)
+    state_path = settings.out / STATE_JSON
+    rows = read_csv(settings.out / RESULTS_CSV, legacy_max_depths(settings, state_path))
+    names = {sc.name for sc in scenes}
+    mine = [r for r in rows if r["scene"] in names]
+    if mine and not spp_given:
+        settings.spp = sorted({r["spp"] for r in mine})
+    if mine and not seeds_given:
+        settings.seeds = sorted({r["seed"] for r in mine})
+    depths = {sc.name: {d for _, d in sc.depth_modes(settings.depths)} for sc in scenes}
+    configs = set(settings.configs)
+    failures = [Failure(**f) for f in read_state(state_path).get("failures", [])]
+    settings.failures = [f for f in failures if f.scene in names
+                         and Config(f.strategy, f.integrator, f.sampler) in configs
+                         and (f.max_depth is None or f.max_depth in depths[f.scene])]
+    return rows
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the study (or rebuild its report); 0 on success, 1 on failure."""
+    argv = sys.argv if argv is None else argv
+    # Stop cleanly (temporary images removed, finished points kept) on SIGTERM too.
+    signal.signal(signal.SIGTERM, lambda *_: (_ for _ in ()).throw(KeyboardInterrupt()))
+    args = build_parser().parse_args(argv[1:])
+    settings = resolve_settings(args, argv)
+    started = datetime.datetime.now(datetime.timezone.utc)
+    t0 = time.monotonic()
+    log(f"output: {settings.out}")
+    scenes = [load_scene(s, settings) for s in settings.scenes]
+    if settings.report_only:
+        rows = report_only_inputs(settings, scenes, args.spp is not None, args.seeds is not None)
+    else:
+        rows = run_study(settings, scenes)
+    samplers = run_sampler_bench(settings)
+    selected = select_rows(rows, settings, scenes)
+    tables, summary, analysis = build_tables(selected, settings, scenes, samplers)
+    figures = make_efficiency_plots(analysis, settings, scene_panels(scenes, settings))
+    figures += make_slice_plots(slice_rows(selected, settings, scenes), settings, [sc.name for sc in scenes])
+    write_report(settings, scenes, tables, figures, started)
+    log(f"done in {format_duration(time.monotonic() - t0)}: {settings.out / REPORT_MD}")
+    ok = not [f for f in settings.failures if not f.unavailable]
+    if settings.check:
+        ok = run_checks(settings, selected, scenes, summary, figures) and ok
+    return 0 if ok else 1
+
+
+def run(argv: list[str] | None = None) -> int:
+    """main() as a command's exit status: 130, with a note, when interrupted (Ctrl-C, SIGTERM)."""
+    try:
+        return main(argv)
+    except KeyboardInterrupt:
+        print("\nstudy: interrupted; the points finished so far are in the CSV, "
+              "run the same command again to resume", file=sys.stderr)
+        return 130

@@ -1,0 +1,394 @@
+"""Constants, the study's types (configurations, scenes, references, failures, settings) and the command line."""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import os
+import shlex
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+
+# This file is scripts/mcrt_study/config.py.
+REPO_ROOT = Path(__file__).resolve().parent.parent.parent
+SCENES_DIR = REPO_ROOT / "scenes"
+
+CSV_COLUMNS = ["scene", "strategy", "integrator", "sampler", "max_depth", "spp", "seed",
+               "seconds", "rmse", "mse", "relmse"]
+# The CSV of the earlier, single-integrator study: read, then rewritten as CSV_COLUMNS.
+OLD_CSV_COLUMNS = ["scene", "strategy", "spp", "seed", "seconds", "rmse", "mse", "relmse"]
+STRATEGIES = ["area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle", "auto"]
+# The default sweep (the committed report); the others by --strategies.
+DEFAULT_STRATEGIES = ["area", "solid-angle"]
+# References with --ref-strategy preferred: the first this mcrt has for the scene.
+REF_STRATEGY_PREFERENCE = ["solid-angle", "area"]
+INTEGRATORS = ["mixture", "nee", "mis"]
+SAMPLERS = ["independent", "stratified", "sobol"]
+DEPTH_MODES = ["global", "direct"]
+DIRECT_MAX_DEPTH = 1
+# What mcrt uses when a scene file gives no max_depth (src/scene_loader.hpp).
+MCRT_DEFAULT_MAX_DEPTH = 50
+# How the earlier study rendered: its points and references are these.
+LEGACY_INTEGRATOR = "mixture"
+LEGACY_SAMPLER = "independent"
+
+DEFAULT_SCENES = ["cornell_rect", "cornell_rect_large", "cornell_disk", "cornell_disk_large"]
+DEFAULT_SPP = [8, 32, 128]
+DEFAULT_SEEDS = [1, 2, 3]
+# The full study renders at this fraction of the scenes' own resolution (same spp).
+DEFAULT_SCALE = 0.5
+DEFAULT_REF_SPP = 4096
+DEFAULT_REF_SEED = 7919
+DEFAULT_REF_INTEGRATOR = "mis"
+DEFAULT_REF_SAMPLER = "sobol"
+DEFAULT_OUT = REPO_ROOT / "bench" / "results"
+
+QUICK_SPP = [4, 8, 16, 32]
+QUICK_SEEDS = [1]
+QUICK_REF_SPP = 1024
+QUICK_SIZE = 48
+QUICK_INTEGRATORS = ["mixture", "mis"]
+QUICK_SAMPLERS = ["independent", "sobol"]
+QUICK_OUT = REPO_ROOT / "build" / "study-quick"
+
+RESULTS_CSV = "results.csv"
+STATE_JSON = "study_state.json"
+TABLES_MD = "tables.md"
+REPORT_MD = "README.md"
+SAMPLERS_JSON = "samplers.json"
+REFERENCES_DIR = "references"
+STATE_VERSION = 2
+
+# Files every complete run writes (the per-scene difference plots are added
+# when both strategies have points, the efficiency plots per depth mode).
+COMMON_PLOTS = ["rmse_vs_spp.png", "time_vs_spp.png", "rmse_vs_time.png", "efficiency.png"]
+
+STRATEGY_STYLE = {
+    "area": {"color": "tab:blue", "label": "area"},
+    "solid-angle": {"color": "tab:orange", "label": "solid angle"},
+    "projected-solid-angle": {"color": "tab:green", "label": "projected solid angle"},
+    "bilinear-solid-angle": {"color": "tab:purple", "label": "bilinear solid angle"},
+    "auto": {"color": "tab:red", "label": "auto (per shading point)"},
+}
+
+SAMPLER_DESCRIPTIONS = {
+    "BM_SampleRectArea": "rectangle, by area",
+    "BM_SampleRectSolidAngle": "rectangle, by solid angle (spherical rectangle)",
+    "BM_SampleRectSolidAngleExact": "rectangle, by solid angle, exact path only",
+    "BM_SampleEllipseArea": "disk/ellipse, by area",
+    "BM_SampleEllipseSolidAngle": "disk/ellipse, by solid angle (parallel map, Newton)",
+    "BM_SampleEllipseSolidAnglePolar": "disk/ellipse, by solid angle (polar map, Newton)",
+    "BM_SampleEllipseSolidAngleBisectionSimpson": "disk/ellipse, by solid angle (parallel map, the seed's bisection + Simpson)",
+}
+
+NOT_AVAILABLE_MARKER = "not available in this build"
+
+# For the progress bar's estimate only: the fixed cost of one mcrt process
+# (start, scene set-up, image input/output), counted as this many samples of
+# work, and rough relative costs per sample (mixture, global depth = 1).
+PROCESS_OVERHEAD_SAMPLES = 1_000_000
+INTEGRATOR_COST = {"mixture": 1.0, "nee": 1.8, "mis": 1.8}
+STRATEGY_COST = {"area": 1.0, "solid-angle": 1.9, "projected-solid-angle": 2.5, "bilinear-solid-angle": 2.2,
+                 "auto": 1.5}
+DIRECT_COST = 0.55
+
+
+@dataclass(frozen=True)
+class Config:
+    """One configuration of the renderer: light-sampling strategy, integrator, sample generator."""
+
+    strategy: str
+    integrator: str
+    sampler: str
+
+    @property
+    def label(self) -> str:
+        """Short name for logs and file names: integrator/sampler/strategy."""
+        return f"{self.integrator}/{self.sampler}/{self.strategy}"
+
+
+# The configuration every other is compared with: the earlier study's area sampling.
+BASELINE = Config("area", LEGACY_INTEGRATOR, LEGACY_SAMPLER)
+
+
+def config_of(row: dict) -> Config:
+    """The configuration a CSV row was rendered with."""
+    return Config(row["strategy"], row["integrator"], row["sampler"])
+
+
+@dataclass(frozen=True)
+class SceneInfo:
+    """A scene of the study: its name, file, content hash, render size and global max depth."""
+
+    name: str
+    path: Path
+    content_sha256: str
+    width: int
+    height: int
+    max_depth: int  # the global mode's: --max-depth, else the scene's, else mcrt's default
+
+    def depth(self, mode: str) -> int:
+        """The max depth passed to mcrt in a depth mode (global or direct)."""
+        return DIRECT_MAX_DEPTH if mode == "direct" else self.max_depth
+
+    def depth_modes(self, modes: list[str]) -> list[tuple[str, int]]:
+        """(mode, max depth) for the selected modes, without repeating a depth.
+
+        When the global depth is 1 itself, direct is the same render and is
+        left out.
+        """
+        pairs: list[tuple[str, int]] = []
+        for mode in modes:
+            if all(d != self.depth(mode) for _, d in pairs):
+                pairs.append((mode, self.depth(mode)))
+        return pairs
+
+
+@dataclass
+class Reference:
+    """A cached reference image and how it was made."""
+
+    scene: str
+    mode: str
+    max_depth: int
+    path: Path
+    key: str
+    strategy: str
+    integrator: str
+    sampler: str
+    spp: int
+    seed: int
+    seconds: float
+    cached: bool
+
+
+@dataclass
+class Failure:
+    """A (scene, configuration, max depth) that could not be run, and why."""
+
+    scene: str
+    strategy: str
+    message: str
+    unavailable: bool  # True: "not available in this build" (expected for now)
+    integrator: str = LEGACY_INTEGRATOR
+    sampler: str = LEGACY_SAMPLER
+    max_depth: int | None = None  # None: every depth (failures recorded by the earlier study)
+
+
+@dataclass
+class Settings:
+    """Everything a run needs, resolved from the command line."""
+
+    mcrt: Path
+    bench: Path | None
+    out: Path
+    scenes: list[str]
+    strategies: list[str]
+    integrators: list[str]
+    samplers: list[str]
+    depths: list[str]
+    spp: list[int]
+    seeds: list[int]
+    ref_spp: int
+    ref_seed: int
+    ref_strategy: str
+    ref_integrator: str
+    ref_sampler: str
+    ref_key_binary: bool
+    width: int | None
+    height: int | None
+    max_depth: int | None
+    threads: int | None
+    budgets: list[float] | None
+    bench_min_time: float
+    bench_repetitions: int
+    quick: bool
+    fresh: bool
+    report_only: bool
+    check: bool
+    command_line: str
+    failures: list[Failure] = field(default_factory=list)
+
+    @property
+    def configs(self) -> list[Config]:
+        """Every selected configuration, in table order (strategies of one integrator and sampler adjacent)."""
+        axes = itertools.product(self.integrators, self.samplers, self.strategies)
+        return [Config(s, i, m) for i, m, s in axes]
+
+
+def parse_int_list(tokens: list[str]) -> list[int]:
+    """Parse integers given as separate tokens, comma lists or A:B[:STEP] ranges (inclusive)."""
+    values: list[int] = []
+    for token in tokens:
+        for part in token.split(","):
+            part = part.strip()
+            if not part:
+                continue
+            if ":" in part:
+                bits = [int(b) for b in part.split(":")]
+                if len(bits) not in (2, 3):
+                    raise argparse.ArgumentTypeError(f"bad range {part!r}: use A:B or A:B:STEP")
+                start, stop = bits[0], bits[1]
+                step = bits[2] if len(bits) == 3 else 1
+                if step <= 0:
+                    raise argparse.ArgumentTypeError(f"bad range {part!r}: STEP must be positive")
+                values.extend(range(start, stop + 1, step))
+            else:
+                values.append(int(part))
+    return values
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The command-line interface."""
+    p = argparse.ArgumentParser(
+        prog="study.py",
+        description="Error against run time of the renderer's configurations: light-sampling "
+        "strategy x integrator x sampler x depth mode (references, RMSE/time sweeps, "
+        "tables, plots, report).",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="See the docstring of scripts/mcrt_study/__init__.py for details.",
+    )
+    p.add_argument("--quick", action="store_true",
+                   help=f"tiny study: {QUICK_SIZE}x{QUICK_SIZE}, spp {','.join(map(str, QUICK_SPP))}, "
+                   f"one seed, integrators {' '.join(QUICK_INTEGRATORS)}, samplers "
+                   f"{' '.join(QUICK_SAMPLERS)}, {QUICK_REF_SPP} spp references, output in "
+                   "build/study-quick (each of these can still be overridden)")
+    p.add_argument("--mcrt", type=Path, default=REPO_ROOT / "build" / "mcrt",
+                   help="mcrt executable (default: build/mcrt)")
+    p.add_argument("--bench", type=Path, default=None,
+                   help="mcrt_bench_samplers executable (default: beside the mcrt executable; "
+                   "skipped if missing)")
+    p.add_argument("--no-bench", action="store_true", help="do not run the sampler benchmark")
+    p.add_argument("--out", type=Path, default=None,
+                   help="output directory (default: bench/results, or build/study-quick with --quick)")
+    p.add_argument("--scenes", nargs="+", default=None,
+                   help="scene names in scenes/ or paths to scene files "
+                   f"(default: {' '.join(DEFAULT_SCENES)})")
+    p.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=None,
+                   help="light-sampling strategies (default: area solid-angle)")
+    p.add_argument("--integrators", nargs="+", choices=INTEGRATORS, default=None,
+                   help="integrators (default: all three; --quick: "
+                   f"{' '.join(QUICK_INTEGRATORS)})")
+    p.add_argument("--samplers", nargs="+", choices=SAMPLERS, default=None,
+                   help="sample generators (default: all three; --quick: "
+                   f"{' '.join(QUICK_SAMPLERS)})")
+    p.add_argument("--depths", nargs="+", choices=DEPTH_MODES, default=None,
+                   help="light-transport modes: global (the scene's max depth, or --max-depth) "
+                   f"and direct (max depth {DIRECT_MAX_DEPTH}: direct lighting only) (default: both)")
+    p.add_argument("--spp", nargs="+", default=None,
+                   help="samples per pixel of the sweep: values, comma lists or A:B:STEP "
+                   f"(default: {' '.join(map(str, DEFAULT_SPP))})")
+    p.add_argument("--seeds", nargs="+", default=None,
+                   help="seeds of the sweep, each spp is rendered once per seed (default: 1 2 3)")
+    p.add_argument("--ref-spp", type=int, default=None,
+                   help=f"samples per pixel of the references (default: {DEFAULT_REF_SPP})")
+    p.add_argument("--ref-seed", type=int, default=DEFAULT_REF_SEED,
+                   help=f"seed of the references, must differ from the sweep's (default: {DEFAULT_REF_SEED})")
+    p.add_argument("--ref-strategy", choices=["preferred", *STRATEGIES], default="preferred",
+                   help="strategy of the references; auto: solid-angle when available, else area")
+    p.add_argument("--ref-integrator", choices=INTEGRATORS, default=DEFAULT_REF_INTEGRATOR,
+                   help=f"integrator of the references (default: {DEFAULT_REF_INTEGRATOR})")
+    p.add_argument("--ref-sampler", choices=SAMPLERS, default=DEFAULT_REF_SAMPLER,
+                   help=f"sample generator of the references (default: {DEFAULT_REF_SAMPLER})")
+    p.add_argument("--ref-key-binary", action="store_true",
+                   help="include a hash of the mcrt binary in the reference cache key")
+    p.add_argument("--width", type=int, default=None,
+                   help=f"image width (default: the scene's x {DEFAULT_SCALE:g}, {QUICK_SIZE} with --quick)")
+    p.add_argument("--height", type=int, default=None,
+                   help=f"image height (default: the scene's x {DEFAULT_SCALE:g}, {QUICK_SIZE} with --quick)")
+    p.add_argument("--max-depth", type=int, default=None,
+                   help="path depth of the global mode (default: the scene's)")
+    p.add_argument("--threads", type=int, default=None,
+                   help="render threads passed to mcrt (default: all hardware threads)")
+    p.add_argument("--budgets", nargs="+", type=float, default=None,
+                   help="time budgets in seconds for the equal-time tables "
+                   "(default: a few per scene and depth mode, spread over the times every "
+                   "configuration reached)")
+    p.add_argument("--bench-min-time", type=float, default=None,
+                   help="--benchmark_min_time in seconds per sampler (default: 0.5, 0.05 with --quick)")
+    p.add_argument("--bench-repetitions", type=int, default=None,
+                   help="benchmark repetitions, the median is reported (default: 3, 1 with --quick)")
+    p.add_argument("--fresh", action="store_true",
+                   help="discard the points of previous runs (cached references are kept)")
+    p.add_argument("--report-only", action="store_true",
+                   help="render nothing: rebuild tables, plots and report from the CSV")
+    p.add_argument("--check", action="store_true",
+                   help="verify the outputs at the end; exit 1 if a check fails")
+    return p
+
+
+def resolve_settings(args: argparse.Namespace, argv: list[str]) -> Settings:
+    """Apply the defaults (full or --quick) to the parsed arguments and validate them."""
+    quick = args.quick
+    mcrt = args.mcrt.resolve()
+    bench: Path | None = None
+    if not args.no_bench:
+        bench = (args.bench or mcrt.parent / "mcrt_bench_samplers").resolve()
+    size = QUICK_SIZE if quick else None
+    settings = Settings(
+        mcrt=mcrt,
+        bench=bench,
+        out=(args.out or (QUICK_OUT if quick else DEFAULT_OUT)).resolve(),
+        scenes=args.scenes or list(DEFAULT_SCENES),
+        strategies=args.strategies or list(DEFAULT_STRATEGIES),
+        integrators=args.integrators or list(QUICK_INTEGRATORS if quick else INTEGRATORS),
+        samplers=args.samplers or list(QUICK_SAMPLERS if quick else SAMPLERS),
+        depths=args.depths or list(DEPTH_MODES),
+        spp=parse_int_list(args.spp) if args.spp else list(QUICK_SPP if quick else DEFAULT_SPP),
+        seeds=parse_int_list(args.seeds) if args.seeds else list(QUICK_SEEDS if quick else DEFAULT_SEEDS),
+        ref_spp=args.ref_spp or (QUICK_REF_SPP if quick else DEFAULT_REF_SPP),
+        ref_seed=args.ref_seed,
+        ref_strategy=args.ref_strategy,
+        ref_integrator=args.ref_integrator,
+        ref_sampler=args.ref_sampler,
+        ref_key_binary=args.ref_key_binary,
+        width=args.width if args.width is not None else size,
+        height=args.height if args.height is not None else size,
+        max_depth=args.max_depth,
+        threads=args.threads,
+        budgets=args.budgets,
+        bench_min_time=args.bench_min_time if args.bench_min_time is not None else (0.05 if quick else 0.5),
+        bench_repetitions=args.bench_repetitions or (1 if quick else 3),
+        quick=quick,
+        fresh=args.fresh,
+        report_only=args.report_only,
+        check=args.check,
+        command_line=shlex.join([repo_relative(sys.executable), repo_relative(argv[0]), *argv[1:]]),
+    )
+    # Keep each axis in its canonical order, without repeats.
+    settings.strategies = [s for s in STRATEGIES if s in settings.strategies]
+    settings.integrators = [s for s in INTEGRATORS if s in settings.integrators]
+    settings.samplers = [s for s in SAMPLERS if s in settings.samplers]
+    settings.depths = [s for s in DEPTH_MODES if s in settings.depths]
+    settings.spp = sorted(set(settings.spp))
+    settings.seeds = list(dict.fromkeys(settings.seeds))
+    problems = []
+    if not settings.spp or min(settings.spp) < 1:
+        problems.append("--spp values must be positive")
+    if not settings.seeds:
+        problems.append("--seeds needs at least one seed")
+    if settings.ref_seed in settings.seeds:
+        problems.append(f"--ref-seed {settings.ref_seed} must differ from the sweep seeds")
+    if settings.ref_spp < 1:
+        problems.append("--ref-spp must be positive")
+    for name, value in (("--width", settings.width), ("--height", settings.height),
+                        ("--threads", settings.threads), ("--max-depth", settings.max_depth)):
+        if value is not None and value < 1:
+            problems.append(f"{name} must be positive")
+    if settings.budgets and min(settings.budgets) <= 0:
+        problems.append("--budgets must be positive")
+    if not settings.report_only and not (settings.mcrt.is_file() and os.access(settings.mcrt, os.X_OK)):
+        problems.append(f"mcrt executable not found: {settings.mcrt} (build it, or pass --mcrt)")
+    if problems:
+        raise SystemExit("study.py: " + "; ".join(problems))
+    return settings
+
+
+def repo_relative(path: str) -> str:
+    """A path relative to the repository root when it lies inside it, else as given."""
+    try:
+        return str(Path(os.path.abspath(path)).relative_to(REPO_ROOT))
+    except ValueError:
+        return path

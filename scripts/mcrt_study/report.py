@@ -1,0 +1,410 @@
+"""Markdown tables and the report (README.md) of a study."""
+
+from __future__ import annotations
+
+import datetime
+import math
+import os
+import platform
+import subprocess
+from pathlib import Path
+
+from .analysis import (
+    analyse_configs, baseline_config, default_budgets, efficiency_ratio, group_stats, interp_loglog,
+    loglog_slope, mean_curve, scene_panels, slice_of, slice_rows,
+)
+from .config import (
+    Config, DIRECT_MAX_DEPTH, Failure, LEGACY_INTEGRATOR, LEGACY_SAMPLER, REPORT_MD, REPO_ROOT,
+    RESULTS_CSV, SAMPLER_DESCRIPTIONS, STATE_JSON, SceneInfo, Settings, TABLES_MD, repo_relative,
+)
+from .results import read_state, state_key
+from .util import sha256_file, write_text_atomic
+
+
+def fmt(value: float, digits: int = 4) -> str:
+    """A number for a table: significant digits, '–' for nan."""
+    if value is None or not math.isfinite(value):
+        return "–"
+    return f"{value:.{digits}g}"
+
+
+def md_table(header: list[str], rows: list[list[str]], text_columns: int = 1) -> str:
+    """A markdown table; the first `text_columns` columns are left-aligned, the rest right-aligned."""
+    align = ["---" if i < text_columns else "---:" for i in range(len(header))]
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join(align) + "|"]
+    lines += ["| " + " | ".join(r) + " |" for r in rows]
+    return "\n".join(lines) + "\n"
+
+
+def build_slice_tables(rows: list[dict], settings: Settings, scenes: list[str]) -> tuple[str, dict]:
+    """The earlier study's tables (convergence, equal time, sweep: area against solid angle) for
+    the rows of its slice, and the numbers the checks use."""
+    parts: list[str] = []
+    summary: dict = {"slopes": {}, "equal_time": []}
+
+    # Convergence: slopes and efficiency.
+    slope_rows = []
+    for scene in scenes:
+        for strategy in settings.strategies:
+            st = group_stats(rows, scene=scene, strategy=strategy)
+            if not len(st["spp"]):
+                continue
+            rmse, _, _ = mean_curve(st, "rmse")
+            secs, _, _ = mean_curve(st, "seconds")
+            mse, _, _ = mean_curve(st, "mse")
+            slope = loglog_slope(st["spp"], rmse)
+            summary["slopes"][(scene, strategy)] = slope
+            eff = [float((1.0 / (m * s)).mean()) for m, s in zip(st["mse"], st["seconds"])]
+            rel = mean_curve(st, "relmse")[0]
+            slope_rows.append([scene, strategy, str(len(st["spp"])), fmt(slope, 3),
+                               fmt(float(secs[-1] / st["spp"][-1]) * 1e3, 3), fmt(float(rmse[-1])),
+                               fmt(float(rel[-1])), fmt(float(sum(eff) / len(eff)), 3)])
+    parts.append("### Convergence\n\nRMSE ∝ spp^slope (least squares in log-log over the mean RMSE "
+                 "per spp; Monte-Carlo convergence gives −0.5). ms/spp and the errors are at the "
+                 "largest spp; efficiency is 1/(MSE·seconds), averaged over the sweep.\n\n")
+    parts.append(md_table(["scene", "strategy", "spp values", "slope", "ms per spp", "RMSE (max spp)",
+                           "relMSE (max spp)", "mean efficiency"], slope_rows, 2))
+
+    # Equal time.
+    et_rows = []
+    for scene in scenes:
+        curves = {}
+        for strategy in settings.strategies:
+            st = group_stats(rows, scene=scene, strategy=strategy)
+            if len(st["spp"]) >= 2:
+                curves[strategy] = (mean_curve(st, "seconds")[0], mean_curve(st, "rmse")[0])
+        if len(curves) < 2:
+            continue
+        budgets = settings.budgets or default_budgets(curves)
+        for budget in budgets:
+            vals = {s: interp_loglog(budget, t, e) for s, (t, e) in curves.items()}
+            a, sa = vals.get("area", float("nan")), vals.get("solid-angle", float("nan"))
+            ratio = a / sa if math.isfinite(a) and math.isfinite(sa) and sa > 0 else float("nan")
+            summary["equal_time"].append((scene, budget, a, sa, ratio))
+            et_rows.append([scene, fmt(budget, 3), fmt(a), fmt(sa), fmt(ratio, 3),
+                            fmt(ratio * ratio, 3)])
+    parts.append("\n### Equal time\n\nEach strategy's mean RMSE interpolated (log-log) at a render "
+                 "time budget. Ratio > 1: solid-angle sampling has the lower error for the same "
+                 "time; the MSE ratio is the gain in efficiency.\n\n")
+    if et_rows:
+        parts.append(md_table(["scene", "time budget (s)", "RMSE area", "RMSE solid angle",
+                               "RMSE ratio area/SA", "MSE ratio"], et_rows))
+    else:
+        parts.append("_Needs both strategies with at least two spp values and overlapping times._\n")
+
+    # Per-scene sweep.
+    parts.append("\n### Sweep\n\nMean over seeds of the render time (s) and RMSE per spp; "
+                 "ratio = RMSE area / RMSE solid angle at equal spp.\n")
+    for scene in scenes:
+        stats = {s: group_stats(rows, scene=scene, strategy=s) for s in settings.strategies}
+        spps = sorted({int(x) for st in stats.values() for x in st["spp"]})
+        if not spps:
+            continue
+        header = ["spp"]
+        for s in settings.strategies:
+            header += [f"time {s}", f"RMSE {s}"]
+        if len(settings.strategies) == 2:
+            header.append("ratio")
+        table = []
+        for spp in spps:
+            line = [str(spp)]
+            rm = {}
+            for s in settings.strategies:
+                st = stats[s]
+                idx = [i for i, x in enumerate(st["spp"]) if int(x) == spp]
+                if idx:
+                    i = idx[0]
+                    rm[s] = float(st["rmse"][i].mean())
+                    line += [fmt(float(st["seconds"][i].mean()), 3), fmt(rm[s])]
+                else:
+                    line += ["–", "–"]
+            if len(settings.strategies) == 2:
+                ok = len(rm) == 2 and rm.get("solid-angle", 0) > 0
+                line.append(fmt(rm["area"] / rm["solid-angle"], 3) if ok else "–")
+            table.append(line)
+        parts.append(f"\n#### {scene}\n\n")
+        parts.append(md_table(header, table))
+
+    return "".join(parts), summary
+
+
+def sampler_cost_table(samplers: list[dict] | None) -> str:
+    """The sampler costs of mcrt_bench_samplers as a markdown section."""
+    parts = ["\n### Sampler cost\n\n"]
+    if samplers:
+        parts.append("mcrt_bench_samplers (Google Benchmark): one sample plus its pdf, over observers "
+                     "spread around the light; CPU time, and wall-clock time in brackets.\n\n")
+        area_ref = {"Rect": None, "Ellipse": None}
+        for s in samplers:
+            for shape in area_ref:
+                if s["name"] == f"BM_Sample{shape}Area":
+                    area_ref[shape] = s["cpu_ns"]
+        srows = []
+        for s in samplers:
+            shape = "Rect" if "Rect" in s["name"] else "Ellipse" if "Ellipse" in s["name"] else None
+            base = area_ref.get(shape) if shape else None
+            srows.append([f"`{s['name']}`", SAMPLER_DESCRIPTIONS.get(s["name"], s["description"]), f"{s['cpu_ns']:.1f} ({s['real_ns']:.1f})",
+                          fmt(s["cpu_ns"] / base, 3) if base else "–"])
+        parts.append(md_table(["benchmark", "sampler", "ns per sample", "× area sampler"], srows, 2))
+    else:
+        parts.append("_Not measured (mcrt_bench_samplers not built or --no-bench)._\n")
+    return "".join(parts)
+
+
+def panel_title(scene: str, mode: str, depth: int) -> str:
+    """A (scene, depth mode) for headings: 'cornell_rect, global (max depth 50)'."""
+    return f"{scene}, {mode} (max depth {depth})"
+
+
+def config_cells(config: Config) -> list[str]:
+    """The integrator, sampler and strategy columns of a configuration's table row."""
+    return [config.integrator, config.sampler, config.strategy]
+
+
+def bold(text: str, on: bool) -> str:
+    """Markdown bold when `on`."""
+    return f"**{text}**" if on else text
+
+
+def build_config_tables(analysis: dict, settings: Settings,
+                        panels: list[tuple[str, str, int]]) -> tuple[str, dict]:
+    """The tables over every configuration: efficiency (overview and per scene and depth mode),
+    MSE at equal time, RMSE slopes; and the numbers the checks use."""
+    base = baseline_config(settings)
+    configs = [c for c in settings.configs if any(c in analysis[(sc, d)] for sc, _, d in panels)]
+    summary: dict = {"efficiency": {}, "config_slopes": {}, "best": {}}
+    parts: list[str] = []
+    if not configs:
+        return "### Efficiency by configuration\n\n_No points._\n", summary
+    for scene, _, depth in panels:
+        per = analysis[(scene, depth)]
+        summary["efficiency"][(scene, depth)] = {c: a["efficiency"] for c, a in per.items()}
+        for c, a in per.items():
+            summary["config_slopes"][(scene, depth, c)] = a["slope"]
+        finite = {c: a["efficiency"] for c, a in per.items() if math.isfinite(a["efficiency"])}
+        if finite:
+            summary["best"][(scene, depth)] = max(finite, key=finite.get)
+
+    def ratio(scene: str, depth: int, config: Config) -> float:
+        return efficiency_ratio(analysis, base, scene, depth, config)
+
+    # Efficiency: overview, then one table per scene and depth mode.
+    parts.append(
+        "### Efficiency by configuration\n\n"
+        "Efficiency = 1/(MSE × seconds) of a render (MSE against the reference, seconds = "
+        "`render_seconds`); a configuration's efficiency is the **geometric mean over all its "
+        f"renders** (every spp and seed of the sweep: {len(settings.spp)} spp × "
+        f"{len(settings.seeds)} seeds), so it weighs every spp alike. Where the MSE falls faster "
+        "than 1/spp (see the convergence rates below) efficiency grows with spp, and this is the "
+        "efficiency near the geometric middle of the spp list; every configuration has the same "
+        "spp list, so the ratios compare them at equal spp. Ratios are to the baseline "
+        f"({base.integrator}, {base.sampler}, {base.strategy}) of the same scene and depth mode; "
+        "higher is better, the best configuration of each column is in bold. In the tables per "
+        "scene, ± s.e. is the standard error of the geometric mean from the spread of the renders "
+        "over seeds at equal spp (machine-speed and Monte-Carlo noise, not the trend over spp); "
+        "ms per spp is at the largest spp.\n\n")
+    header = ["integrator", "sampler", "strategy"]
+    header += [f"{scene} {mode}" for scene, mode, _ in panels]
+    table = []
+    for c in configs:
+        line = config_cells(c)
+        for scene, _, depth in panels:
+            line.append(bold(fmt(ratio(scene, depth, c), 3), summary["best"].get((scene, depth)) == c))
+        table.append(line)
+    parts.append(md_table(header, table, 3))
+    for scene, mode, depth in panels:
+        per = analysis[(scene, depth)]
+        parts.append(f"\n#### {panel_title(scene, mode, depth)}\n\n")
+        if not per:
+            parts.append("_No points._\n")
+            continue
+        table = []
+        for c in configs:
+            if c not in per:
+                continue
+            a = per[c]
+            best = summary["best"].get((scene, depth)) == c
+            table.append([*config_cells(c), str(a["n"]), bold(fmt(a["efficiency"], 4), best),
+                          f"±{fmt(100 * a['rel_se'], 2)} %", bold(fmt(ratio(scene, depth, c), 3), best),
+                          fmt(a["ms_per_spp"], 3), "★ best" if best else ""])
+        parts.append(md_table(["integrator", "sampler", "strategy", "renders", "efficiency",
+                               "± s.e.", "× baseline", "ms per spp", ""], table, 3))
+
+    # Equal time.
+    parts.append(
+        "\n### Equal time by configuration\n\n"
+        "Mean MSE over seeds of each configuration, interpolated (log-log, in render time) at a "
+        "few time budgets per scene and depth mode, spread over the times every configuration "
+        "reached (– outside a configuration's range); the lowest MSE of each budget in bold. "
+        "Last column: baseline MSE / MSE, geometric mean over the budgets (> 1: better than the "
+        "baseline at equal time).\n")
+    for scene, mode, depth in panels:
+        per = analysis[(scene, depth)]
+        curves = {c: (mean_curve(a["stats"], "seconds")[0], mean_curve(a["stats"], "mse")[0])
+                  for c, a in per.items() if len(a["stats"]["spp"]) >= 2}
+        if not curves:
+            continue
+        budgets = settings.budgets or default_budgets(curves, 3)
+        if not budgets and base in curves:  # no time common to all: the baseline's range
+            budgets = default_budgets({base: curves[base]}, 3)
+        if not budgets:
+            continue
+        mse = {c: [interp_loglog(b, t, e) for b in budgets] for c, (t, e) in curves.items()}
+        lowest = [min((m[i] for m in mse.values() if math.isfinite(m[i])), default=float("nan"))
+                  for i in range(len(budgets))]
+        table = []
+        for c in configs:
+            if c not in mse:
+                continue
+            gains = [mse[base][i] / m for i, m in enumerate(mse[c])
+                     if base in mse and math.isfinite(m) and math.isfinite(mse[base][i]) and m > 0]
+            gain = math.exp(sum(map(math.log, gains)) / len(gains)) if gains else float("nan")
+            table.append([*config_cells(c), *[bold(fmt(m, 4), m == lowest[i]) for i, m in enumerate(mse[c])],
+                          fmt(gain, 3)])
+        parts.append(f"\n#### {panel_title(scene, mode, depth)}\n\n")
+        parts.append(md_table(["integrator", "sampler", "strategy",
+                               *[f"MSE at {fmt(b, 3)} s" for b in budgets], "baseline MSE / MSE"], table, 3))
+
+    # Convergence rates.
+    parts.append(
+        "\n### Convergence rate by configuration\n\n"
+        "Log-log slope of the mean RMSE (over seeds) against spp, least squares. Monte-Carlo "
+        "noise alone gives −0.5; a stratified or quasi-Monte-Carlo sampler can do better (steeper) "
+        "where the integrand is smooth, as in direct lighting, and tends to −0.5 when long paths "
+        "make the integrand high-dimensional. The image error also holds the pixel-footprint "
+        "(antialiasing) error, which falls faster than Monte-Carlo noise when the pixel positions "
+        "are stratified, so even the independent sampler can show slopes below −0.5, more so at "
+        "low resolution and where the lighting noise is small (direct lighting, NEE): compare a "
+        "sampler's slope with the independent sampler's of the same integrator, strategy and "
+        "mode.\n\n")
+    table = []
+    for c in configs:
+        table.append([*config_cells(c), *[fmt(analysis[(sc, d)][c]["slope"], 3) if c in analysis[(sc, d)]
+                                          else "–" for sc, _, d in panels]])
+    parts.append(md_table(["integrator", "sampler", "strategy", *[f"{sc} {m}" for sc, m, _ in panels]],
+                          table, 3))
+    return "".join(parts), summary
+
+
+def build_tables(rows: list[dict], settings: Settings, scenes: list[SceneInfo],
+                 samplers: list[dict] | None) -> tuple[str, dict, dict]:
+    """All markdown tables of the report; the numbers the checks use; the per-configuration
+    analysis (for the plots)."""
+    panels = scene_panels(scenes, settings)
+    analysis = analyse_configs(rows, settings, panels)
+    config_text, summary = build_config_tables(analysis, settings, panels)
+    integrator, sampler, mode = slice_of(settings)
+    slice_text, slice_summary = build_slice_tables(slice_rows(rows, settings, scenes), settings,
+                                                   [sc.name for sc in scenes])
+    summary.update(slice_summary)
+    intro = (f"\n## Area against solid angle: {integrator}, {sampler}, {mode} depth\n\n"
+             "The tables of the earlier, single-configuration study, for the slice integrator "
+             f"{integrator}, sampler {sampler}, {mode} depth mode.\n\n")
+    text = config_text + intro + slice_text + sampler_cost_table(samplers)
+    return text, summary, analysis
+
+
+def machine_info() -> dict[str, str]:
+    """CPU model, core count, OS, and the repository's git commit."""
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text(encoding="utf-8").splitlines():
+            if line.lower().startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    commit = "unknown"
+    try:
+        head = subprocess.run(["git", "-C", str(REPO_ROOT), "rev-parse", "HEAD"],
+                              capture_output=True, text=True, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "-C", str(REPO_ROOT), "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, check=True).stdout.strip()
+        commit = head + (" (with uncommitted changes)" if dirty else "")
+    except (OSError, subprocess.CalledProcessError):
+        pass
+    return {"cpu": cpu, "cores": str(os.cpu_count() or "?"),
+            "os": f"{platform.system()} {platform.release()}", "commit": commit,
+            "python": platform.python_version()}
+
+
+def failure_lines(failures: list[Failure]) -> list[str]:
+    """The report's lines for skipped or failed configurations, one per scene, strategy and reason."""
+    grouped: dict[tuple, list[str]] = {}
+    for f in failures:
+        where = f"{f.integrator}/{f.sampler}" + (f" at max depth {f.max_depth}" if f.max_depth is not None else "")
+        grouped.setdefault((f.scene, f.strategy, f.unavailable, f.message), []).append(where)
+    lines = []
+    for (scene, strategy, unavailable, message), where in grouped.items():
+        kind = "not available in this mcrt build, skipped" if unavailable else "**failed**"
+        lines.append(f"- {scene}, {strategy} ({'; '.join(dict.fromkeys(where))}): {kind} — `{message}`")
+    return lines
+
+
+def write_report(settings: Settings, scenes: list[SceneInfo], tables: str,
+                 figures: list[tuple[str, str]], started: datetime.datetime) -> None:
+    """Write tables.md and the report README.md (relative links to the plots)."""
+    out = settings.out
+    write_text_atomic(out / TABLES_MD, tables)
+    info = machine_info()
+    state = read_state(out / STATE_JSON)
+    mcrt_hash = sha256_file(settings.mcrt)[:12] if settings.mcrt.is_file() else "?"
+    threads = str(settings.threads) if settings.threads else f"all ({info['cores']})"
+    base = baseline_config(settings)
+    modes = {"global": "global (the scene's max depth" + (", --max-depth" if settings.max_depth else "") + ")",
+             "direct": f"direct (max depth {DIRECT_MAX_DEPTH}: direct lighting only)"}
+
+    lines = [
+        "# Error against run time: light sampling, integrators and samplers\n",
+        f"Generated by `scripts/study.py` on {started.strftime('%Y-%m-%d %H:%M UTC')}"
+        + (" (**--quick**: a smoke test, not a measurement)" if settings.quick else "") + ".\n",
+        "## Setup\n",
+        f"- Command: `{settings.command_line}`",
+        f"- Commit: `{info['commit']}`",
+        f"- Machine: {info['cpu']}, {info['cores']} cores, {info['os']}; render threads: {threads}",
+        f"- mcrt: `{repo_relative(str(settings.mcrt))}` (sha256 {mcrt_hash}…)",
+        f"- Scenes: {', '.join(sc.name for sc in scenes)}",
+        f"- Configurations ({len(settings.configs)}): integrators {', '.join(settings.integrators)}; "
+        f"samplers {', '.join(settings.samplers)}; strategies {', '.join(settings.strategies)}; "
+        f"in the depth modes {' and '.join(modes[m] for m in settings.depths)}",
+        f"- Sweep: spp {', '.join(map(str, settings.spp))}; seeds {', '.join(map(str, settings.seeds))}; "
+        "for each seed and spp every depth mode and configuration in turn",
+        "- Time: `render_seconds` of `mcrt render --stats` (rendering only: no process start, "
+        "no scene parsing, no image output). Error: `mcrt diff --json` against the reference "
+        "(relMSE as in pbrt: mean of (v−r)²/(r+0.01)²).",
+        "- Efficiency: 1/(MSE × seconds) of each render; a configuration's is the geometric mean "
+        "over its renders (every spp and seed), compared with the baseline "
+        f"({base.integrator}, {base.sampler}, {base.strategy}) of the same scene and depth mode.",
+        f"- Data: [{RESULTS_CSV}]({RESULTS_CSV}) (one row per render), tables also in [{TABLES_MD}]({TABLES_MD}).\n",
+        "### References\n",
+        "One reference per scene and depth mode with a seed the sweep does not use, shared by "
+        "every configuration (all converge to the same image); the table gives the configuration "
+        f"each was rendered with (this run's choice: integrator {settings.ref_integrator}, sampler "
+        f"{settings.ref_sampler}, "
+        + ("solid-angle sampling where this mcrt build supports it, else area sampling"
+           if settings.ref_strategy == "preferred" else f"{settings.ref_strategy} sampling")
+        + "). Cached by scene content, resolution, spp, max depth, seed, strategy, integrator and sampler.\n",
+    ]
+    ref_rows = []
+    for scene, mode, depth in scene_panels(scenes, settings):
+        s = state.get("runs", {}).get(state_key(scene, depth))
+        if s:
+            ref = s["reference"]
+            ref_rows.append([scene, mode, ref.get("integrator", LEGACY_INTEGRATOR),
+                             ref.get("sampler", LEGACY_SAMPLER), ref["strategy"], f"{s['width']}×{s['height']}",
+                             str(depth), str(ref["spp"]), str(ref["seed"]),
+                             fmt(ref.get("render_seconds", float("nan")), 4)])
+    if ref_rows:
+        lines.append(md_table(["scene", "mode", "integrator", "sampler", "strategy", "resolution", "max depth",
+                               "spp", "seed", "render time (s)"], ref_rows, 5))
+    if settings.failures:
+        lines.append("### Skipped or failed\n")
+        lines += failure_lines(settings.failures)
+        lines.append("")
+    lines.append("## Results\n")
+    lines.append(tables)
+    if figures:
+        lines.append("\n## Plots\n")
+        for name, caption in figures:
+            lines.append(f"![{name}]({name})\n\n{caption}\n")
+    write_text_atomic(out / REPORT_MD, "\n".join(lines) + "\n")

@@ -1,0 +1,270 @@
+"""The sweep: references and renders of every scene, depth mode and configuration; the sampler benchmark."""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import json
+import os
+import shutil
+import subprocess
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+from .config import (
+    Config, DIRECT_COST, DIRECT_MAX_DEPTH, Failure, INTEGRATOR_COST, PROCESS_OVERHEAD_SAMPLES,
+    RESULTS_CSV, Reference, SAMPLERS_JSON, SAMPLER_DESCRIPTIONS, STATE_JSON, STRATEGY_COST,
+    SceneInfo, Settings, config_of,
+)
+from .mcrt import McrtError, diff, render
+from .references import find_cached_reference, make_reference, reference_strategies
+from .results import (
+    append_csv, empty_state, legacy_max_depths, point_key, read_csv, read_state, row_key,
+    scene_run_key, state_key, write_csv,
+)
+from .util import Progress, log, sha256_file, write_text_atomic
+
+
+def point_work(scene: SceneInfo, config: Config, max_depth: int, spp: int) -> float:
+    """Estimated work of one sweep point, in samples: the render (weighted by rough relative
+    costs) plus two mcrt processes."""
+    cost = (INTEGRATOR_COST[config.integrator] * STRATEGY_COST[config.strategy]
+            * (DIRECT_COST if max_depth == DIRECT_MAX_DEPTH else 1.0))
+    return spp * scene.width * scene.height * cost + 2 * PROCESS_OVERHEAD_SAMPLES
+
+
+def reference_work(settings: Settings, scene: SceneInfo, max_depth: int) -> float:
+    """Estimated work of one reference, in samples."""
+    config = Config(reference_strategies(settings)[0], settings.ref_integrator, settings.ref_sampler)
+    return point_work(scene, config, max_depth, settings.ref_spp) - PROCESS_OVERHEAD_SAMPLES
+
+
+@dataclass
+class Sweep:
+    """What a run changes as it goes: the points so far, the CSV, the state file, the progress bar."""
+
+    settings: Settings
+    rows: list[dict]
+    done: set  # row_key of every point in rows
+    csv_path: Path
+    state: dict
+    state_path: Path
+    progress: Progress
+    tmpdir: Path
+    binary_hash: str
+
+    def save_state(self) -> None:
+        """Write the state file."""
+        write_text_atomic(self.state_path, json.dumps(self.state, indent=2) + "\n")
+
+
+def run_study(settings: Settings, scenes: list[SceneInfo]) -> list[dict]:
+    """References and sweep for every scene, depth mode and configuration; returns all CSV rows."""
+    out = settings.out
+    out.mkdir(parents=True, exist_ok=True)
+    csv_path = out / RESULTS_CSV
+    state_path = out / STATE_JSON
+    if settings.fresh and csv_path.exists():
+        csv_path.unlink()
+    rows = read_csv(csv_path, legacy_max_depths(settings, state_path))
+    state = empty_state() if settings.fresh else read_state(state_path)
+    binary_hash = sha256_file(settings.mcrt) if settings.mcrt.is_file() else ""
+    done = {row_key(r) for r in rows}
+
+    # Work left, to size the progress bar, in samples (spp x pixels x rough
+    # cost plus a fixed cost per process): the remaining sweep points plus the
+    # references not in the cache.
+    total = 0.0
+    pending_refs = set()
+    preferred = reference_strategies(settings)[0]
+    for scene in scenes:
+        for mode, depth in scene.depth_modes(settings.depths):
+            cached = find_cached_reference(settings, scene, mode, binary_hash)
+            if cached is None or cached.strategy != preferred:
+                total += reference_work(settings, scene, depth)
+                pending_refs.add((scene.name, depth))
+            total += sum(point_work(scene, config, depth, spp)
+                         for config, spp, seed in itertools.product(settings.configs, settings.spp, settings.seeds)
+                         if point_key(scene.name, config, depth, spp, seed) not in done)
+    progress = Progress(total)
+    tmpdir = Path(tempfile.mkdtemp(prefix=".sweep-", dir=out))
+    sweep = Sweep(settings, rows, done, csv_path, state, state_path, progress, tmpdir, binary_hash)
+    try:
+        for scene in scenes:
+            references: dict[int, Reference] = {}
+            for mode, depth in scene.depth_modes(settings.depths):
+                reference = prepare_depth(sweep, scene, mode, (scene.name, depth) in pending_refs)
+                if reference is not None:
+                    references[depth] = reference
+            sweep_scene(sweep, scene, references)
+    finally:
+        progress.finish()
+        shutil.rmtree(tmpdir, ignore_errors=True)
+    # Remember what was skipped or failed, for --report-only.
+    state["failures"] = [dataclasses.asdict(f) for f in settings.failures]
+    sweep.save_state()
+    return sweep.rows
+
+
+def prepare_depth(sweep: Sweep, scene: SceneInfo, mode: str, counted: bool) -> Reference | None:
+    """The reference of a scene in a depth mode, with the points already made checked against it.
+
+    When the scene, the resolution, the depth or the reference changed since
+    the points of this scene and depth were made, those points are dropped
+    (and run again). Returns None, with a failure recorded for every
+    configuration, when the reference cannot be rendered. `counted`: the
+    reference's work is in the progress bar's total.
+    """
+    settings, progress = sweep.settings, sweep.progress
+    depth = scene.depth(mode)
+    work = reference_work(settings, scene, depth)
+    try:
+        reference = make_reference(settings, scene, mode, sweep.binary_hash, progress)
+    except McrtError as err:
+        progress.message(f"{scene.name} ({mode}): reference failed: {err}")
+        for config in settings.configs:
+            settings.failures.append(Failure(scene.name, config.strategy, f"reference: {err}", False,
+                                             config.integrator, config.sampler, depth))
+        left = sum(point_work(scene, config, depth, spp)
+                   for config, spp, seed in itertools.product(settings.configs, settings.spp, settings.seeds)
+                   if point_key(scene.name, config, depth, spp, seed) not in sweep.done)
+        progress.advance(left + (work if counted else 0.0), f"{scene.name} ({mode}) reference failed")
+        return None
+    if not reference.cached and not counted:
+        progress.add_work(work)
+    if not reference.cached or counted:
+        progress.advance(work, f"{scene.name} ({mode}) reference ready")
+
+    run_key = scene_run_key(scene, depth, reference)
+    key = state_key(scene.name, depth)
+    previous = sweep.state["runs"].get(key, {}).get("run_key")
+    mine = [r for r in sweep.rows if r["scene"] == scene.name and r["max_depth"] == depth]
+    if previous != run_key and mine:
+        progress.message(f"{scene.name} ({mode}, max depth {depth}): settings or reference changed "
+                         f"since the points in {sweep.csv_path.name} were made; running them again")
+        selected = set(settings.configs)
+        progress.add_work(sum(point_work(scene, config_of(r), depth, r["spp"]) for r in mine
+                              if config_of(r) in selected and r["spp"] in settings.spp
+                              and r["seed"] in settings.seeds))
+        sweep.rows = [r for r in sweep.rows if not (r["scene"] == scene.name and r["max_depth"] == depth)]
+        write_csv(sweep.csv_path, sweep.rows)
+        sweep.done = {row_key(r) for r in sweep.rows}
+    sweep.state["runs"][key] = {
+        "run_key": run_key, "scene": scene.name, "mode": mode, "scene_file": str(scene.path),
+        "width": scene.width, "height": scene.height, "max_depth": depth,
+        "reference": {"file": os.path.relpath(reference.path, settings.out), "strategy": reference.strategy,
+                      "integrator": reference.integrator, "sampler": reference.sampler,
+                      "spp": reference.spp, "seed": reference.seed, "render_seconds": reference.seconds},
+    }
+    sweep.save_state()
+    return reference
+
+
+def sweep_scene(sweep: Sweep, scene: SceneInfo, references: dict[int, Reference]) -> None:
+    """The sweep of one scene: every seed, spp, depth mode and configuration not yet in the CSV.
+
+    For each seed and spp, every depth mode and every configuration is
+    rendered in turn, the order of the configurations rotated by one from
+    each (seed, spp, depth) to the next, so that a change of machine load
+    affects all configurations alike and none is always first.
+    """
+    settings, progress = sweep.settings, sweep.progress
+    configs = settings.configs
+    dead: dict[tuple[int, Config], McrtError] = {}
+    turn = 0
+    for seed in settings.seeds:
+        for spp in settings.spp:
+            for depth, reference in references.items():
+                shift = turn % len(configs)
+                turn += 1
+                for config in configs[shift:] + configs[:shift]:
+                    key = point_key(scene.name, config, depth, spp, seed)
+                    if key in sweep.done or (depth, config) in dead:
+                        continue
+                    label = f"{scene.name} {reference.mode} {config.label} spp={spp} seed={seed}"
+                    image = sweep.tmpdir / (f"{scene.name}-{depth}-{config.strategy}-{config.integrator}-"
+                                            f"{config.sampler}-{spp}-{seed}.exr")
+                    try:
+                        seconds = render(settings, scene, config, depth, spp, seed, image)
+                        errors = diff(settings, image, reference.path)
+                    except McrtError as err:
+                        dead[(depth, config)] = err
+                        kind = "not available in this build, skipped" if err.unavailable else "FAILED"
+                        progress.message(f"{scene.name} ({reference.mode}) {config.label}: {kind}: {err}")
+                        settings.failures.append(Failure(scene.name, config.strategy, str(err), err.unavailable,
+                                                         config.integrator, config.sampler, depth))
+                        left = sum(point_work(scene, config, depth, s) for s in settings.spp for sd in settings.seeds
+                                   if point_key(scene.name, config, depth, s, sd) not in sweep.done)
+                        progress.advance(left, label)
+                        continue
+                    finally:
+                        image.unlink(missing_ok=True)
+                    row = {"scene": scene.name, "strategy": config.strategy, "integrator": config.integrator,
+                           "sampler": config.sampler, "max_depth": depth, "spp": spp, "seed": seed,
+                           "seconds": seconds, **errors}
+                    append_csv(sweep.csv_path, row)
+                    sweep.rows.append(row)
+                    sweep.done.add(key)
+                    progress.advance(point_work(scene, config, depth, spp), label)
+
+
+def run_sampler_bench(settings: Settings) -> list[dict] | None:
+    """Run mcrt_bench_samplers (JSON) and return ns per sample per sampler.
+
+    Returns None when the executable is missing or fails; the raw JSON is
+    kept in OUT/samplers.json. With repetitions the median is used.
+    """
+    raw_path = settings.out / SAMPLERS_JSON
+    if settings.bench is None:
+        return None
+    if settings.report_only:
+        data = json.loads(raw_path.read_text(encoding="utf-8")) if raw_path.is_file() else None
+        return parse_bench(data) if data else None
+    if not settings.bench.is_file():
+        log(f"sampler benchmark not found ({settings.bench}); skipped")
+        return None
+    log(f"sampler benchmark: {settings.bench.name}")
+    base = [str(settings.bench), "--benchmark_format=json"]
+    if settings.bench_repetitions > 1:
+        base += [f"--benchmark_repetitions={settings.bench_repetitions}",
+                 "--benchmark_report_aggregates_only=true"]
+    # Older Google Benchmark takes a plain number of seconds, newer ones want a unit.
+    for min_time in (f"{settings.bench_min_time:g}", f"{settings.bench_min_time:g}s"):
+        proc = subprocess.run([*base, f"--benchmark_min_time={min_time}"], capture_output=True, text=True)
+        if proc.returncode == 0:
+            break
+    else:
+        log(f"sampler benchmark failed: {proc.stderr.strip().splitlines()[-1:] or proc.returncode}")
+        return None
+    data = json.loads(proc.stdout)
+    write_text_atomic(raw_path, json.dumps(data, indent=2) + "\n")
+    return parse_bench(data)
+
+
+def parse_bench(data: dict) -> list[dict]:
+    """ns per sample (CPU and wall clock) per benchmark from Google Benchmark JSON."""
+    scale = {"ns": 1.0, "us": 1e3, "ms": 1e6, "s": 1e9}
+    picked: dict[str, dict] = {}
+    for b in data.get("benchmarks", []):
+        name = b.get("run_name", b["name"])
+        is_median = b.get("run_type") == "aggregate" and b.get("aggregate_name") == "median"
+        is_plain = b.get("run_type", "iteration") == "iteration"
+        if not (is_median or is_plain):
+            continue
+        if name in picked and not is_median:
+            continue
+        unit = scale.get(b.get("time_unit", "ns"), 1.0)
+        items = b.get("items_per_second")
+        iterations_per_item = 1.0
+        if items and b.get("cpu_time"):
+            # items per iteration = items_per_second * cpu_time_per_iteration
+            iterations_per_item = 1.0 / max(items * b["cpu_time"] * unit * 1e-9, 1e-12)
+        picked[name] = {
+            "name": name,
+            "description": SAMPLER_DESCRIPTIONS.get(name, ""),
+            "cpu_ns": b["cpu_time"] * unit * iterations_per_item,
+            "real_ns": b["real_time"] * unit * iterations_per_item,
+        }
+    order = list(SAMPLER_DESCRIPTIONS)
+    return sorted(picked.values(), key=lambda r: (order.index(r["name"]) if r["name"] in order else 99, r["name"]))
