@@ -41,7 +41,7 @@ struct config {
 };
 
 // Receivers around a unit-size light at the origin facing down (-y), from
-// 0.5 to 8 light sizes away, normals up, tilted and grazing.
+// 0.5 to 16 light sizes away, normals up, tilted and grazing.
 std::vector<config> configs() {
   return {
       {"below_near_up", {0.1f, -0.5f, 0.05f}, {0, 1, 0}},
@@ -50,6 +50,7 @@ std::vector<config> configs() {
       {"side_near_up", {1.5f, -0.6f, 0.0f}, {0, 1, 0}},
       {"side_far_wall", {4.0f, -2.0f, 0.5f}, {-1, 0, 0}},
       {"near_grazing", {0.2f, -0.7f, 0.1f}, glm::normalize(vec3(1, 0.05f, 0))},
+      {"below_very_far_tilted", {1.0f, -16.0f, 0.5f}, glm::normalize(vec3(0.3f, 1, 0.2f))},
   };
 }
 
@@ -65,6 +66,7 @@ template <class Shape, class Area, class SolidAngle>
 void check_model(const Shape& shape) {
   const Area area{shape};
   const SolidAngle sa{shape};
+  int delta_used = 0;
   for (const config& c : configs()) {
     const auto model = auto_model(shape, c.o, c.n);
     const double va = measured_relative_variance(area, c.o, c.n, 200'000, 11);
@@ -73,11 +75,19 @@ void check_model(const Shape& shape) {
     EXPECT_TRUE(near(model.v_area(), va)) << c.name << ": model v_area " << model.v_area() << ", measured " << va;
     EXPECT_TRUE(near(model.v_solid_angle(), vs))
         << c.name << ": model v_sa " << model.v_solid_angle() << ", measured " << vs;
-    // The coarse rule that lets area sampling be chosen early must bound
+    // The coarse rules that lets area sampling be chosen early must bound
     // v_area from above once multiplied by 4 (choose_planar).
     if constexpr (requires { auto_model_coarse(shape, c.o, c.n); }) {
       EXPECT_GE(4.0 * auto_model_coarse(shape, c.o, c.n).v_area() + 0.02, va) << c.name << ": coarse v_area x 4";
+      float vd;
+      if (delta_v_area(shape, c.o, c.n, vd)) {
+        ++delta_used;
+        EXPECT_GE(2.0 * vd + 0.02, va) << c.name << ": delta-method v_area x 2";
+      }
     }
+  }
+  if constexpr (requires { auto_model_coarse(shape, vec3(0), vec3(0)); }) {
+    EXPECT_GE(delta_used, 2) << "the delta method applies to the far receivers";
   }
 }
 

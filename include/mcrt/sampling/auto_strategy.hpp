@@ -30,8 +30,10 @@
 // costs from the README's cost tables, c_rest from the error-against-time
 // study (cornell_rect, nee, sobol: ms per spp of area and solid-angle
 // sampling, 318 and 451 ns per path at 1.13 light samples per path, leave
-// 265 ns per light sample for the rest), v_rest fitted to the study's
-// equal-time efficiencies (README, "Choosing per shading point").
+// 265 ns per light sample for the rest), v_rest = 0.25 the value, of those
+// tried (0.25, 1, 4), with the best worst case over the study's scenes
+// (README, "Choosing per shading point", which also says how far this rule
+// is from the best fixed strategy).
 #include <algorithm>
 
 #include "mcrt/core/onb.hpp"
@@ -205,13 +207,52 @@ inline auto_choice auto_model(const sphere& s, const vec3& o, const vec3& n) {
   return ch;
 }
 
-// The choice. Planar lights first try the 2x2 Gauss rule (half the work),
-// which is within a factor 4 of the variances (tests/test_auto_strategy.cpp):
-// where even 4 times its v_area leaves area sampling the best, that is the
-// choice; otherwise the finer rule decides.
+// First-order (delta-method) variances at the centre of a planar light
+// with centre c and axes E1, E2 (offsets s E1 + t E2 over the light with
+// variances k each: 1/12 for a rectangle's edges, 1/4 for an ellipse's
+// semi-axes): log g = log(n . d) - 4 log r + const, d = p - o, so
+// v_area ~ k ((grad log g . E1)^2 + (grad log g . E2)^2) with grad log g =
+// n / (n . d) - 4 d / r^2. Valid (true, with v_area) only where each part
+// of the gradient changes log g by at most 0.3 across the light, so that
+// the first-order term is all that matters (within a factor 2 on the test
+// receivers: tests/test_auto_strategy.cpp).
+inline bool delta_v_area(const vec3& c, const vec3& E1, const vec3& E2, float k, const vec3& o, const vec3& n,
+                         float& v_area) {
+  const vec3 d = c - o;
+  const float r2 = glm::dot(d, d), nd = glm::dot(n, d);
+  if (!(nd > 0.0f) || !(r2 > 0.0f)) return false;
+  const float inv_nd = 1.0f / nd, inv_r2 = 1.0f / r2;
+  const float n1 = glm::dot(n, E1) * inv_nd, n2 = glm::dot(n, E2) * inv_nd;
+  const float d1 = 4.0f * glm::dot(d, E1) * inv_r2, d2 = 4.0f * glm::dot(d, E2) * inv_r2;
+  if (!(0.5f * (std::abs(n1) + std::abs(n2)) <= 0.3f) || !(0.5f * (std::abs(d1) + std::abs(d2)) <= 0.3f)) return false;
+  const float g1 = n1 - d1, g2 = n2 - d2;
+  v_area = k * (g1 * g1 + g2 * g2);
+  return true;
+}
+inline bool delta_v_area(const rect& r, const vec3& o, const vec3& n, float& v) {
+  if (!(glm::dot(o - r.corner, r.n) > 0.0f)) return false;  // behind the light
+  return delta_v_area(r.corner + 0.5f * (r.e1 + r.e2), r.e1, r.e2, 1.0f / 12.0f, o, n, v);
+}
+inline bool delta_v_area(const ellipse& e, const vec3& o, const vec3& n, float& v) {
+  if (!(glm::dot(o - e.center, e.n) > 0.0f)) return false;
+  return delta_v_area(e.center, e.a1, e.a2, 0.25f, o, n, v);
+}
+
+// The choice. Planar lights try two cheap estimates first: the delta
+// method, where valid, then the 2x2 Gauss rule (within a factor 4 of the
+// variances on the test receivers); where even twice, resp. four times,
+// their v_area leaves area sampling the best, that is the choice;
+// otherwise the finer rule decides.
 template <class Planar>
 light_sampling choose_planar(const Planar& l, const vec3& o, const vec3& n, const auto_costs::shape_costs& c,
                              const auto_params& p) {
+  float v_delta;
+  if (delta_v_area(l, o, n, v_delta)) {
+    const float area = (c.area + p.rest_cost) * (2.0f * v_delta + p.rest_variance);
+    if (area <= (c.solid_angle + p.rest_cost) * p.rest_variance &&
+        area <= (c.projected_solid_angle + p.rest_cost) * p.rest_variance)
+      return light_sampling::area;
+  }
   const auto_choice coarse = auto_model_coarse(l, o, n);
   if (coarse.area_wins_even_if(4.0f, c, p)) return light_sampling::area;
   return auto_model(l, o, n).choose(c, p);
@@ -222,9 +263,25 @@ inline light_sampling choose_strategy(const rect& r, const vec3& o, const vec3& 
 inline light_sampling choose_strategy(const ellipse& e, const vec3& o, const vec3& n, const auto_params& p = {}) {
   return choose_planar(e, o, n, auto_costs::ellipse, p);
 }
+// Spheres: a cap above the horizon whose cosine varies little is the
+// cone's without the quadrature. To first order in the cap's size v_sa =
+// tan^2(theta_c) sin^2(alpha) / 4 (cos theta = cos theta_c cos beta + sin
+// theta_c sin beta cos phi, E[beta^2] = alpha^2 / 2 over the cone); where
+// even twice that leaves the cone ahead of the projected cap, the cone it
+// is (area sampling, dearer, is not ahead of the cone there: its estimate
+// also carries the spread of cos theta_l over the visible cap, 1/3 and more).
 inline light_sampling choose_strategy(const sphere& s, const vec3& o, const vec3& n, const auto_params& p = {}) {
-  const bool above = glm::dot(s.center - o, n) >= s.radius * glm::length(n);
-  return auto_model(s, o, n).choose(above ? auto_costs::sphere_above : auto_costs::sphere_crossing, p);
+  const vec3 v = s.center - o;
+  const float h = glm::dot(v, n), r2 = s.radius * s.radius, d2 = glm::dot(v, v);
+  const bool above = h >= s.radius * glm::length(n);
+  const auto_costs::shape_costs& c = above ? auto_costs::sphere_above : auto_costs::sphere_crossing;
+  if (above) {
+    const float v_sa = r2 * (d2 - h * h) / (4.0f * d2 * h * h);  // tan^2(theta_c) sin^2(alpha) / 4
+    if ((c.solid_angle + p.rest_cost) * (2.0f * v_sa + p.rest_variance) <=
+        (c.projected_solid_angle + p.rest_cost) * p.rest_variance)
+      return light_sampling::solid_angle;
+  }
+  return auto_model(s, o, n).choose(c, p);
 }
 
 // The strategy itself: the three samplers of one shape and the per-point
