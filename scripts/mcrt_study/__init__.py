@@ -42,6 +42,16 @@ references ~20 min, mcrt process start-up and image I/O ~10 min).
 samplers independent and sobol, both depth modes, 1024 spp references, output
 in build/study-quick (ignored by git); each of these can still be overridden.
 
+Generated scene families. ``--scenes`` also takes the name of a generated
+family, meaning all its members, or of one member: size_rect, size_disk,
+size_sphere (the Cornell box with its ceiling light a rectangle, disk or
+sphere at 1/16, 1/4, 1, 2, 4, 8 times the seed light's area, equal radiance
+times (projected) area; members size_rect_1of16 ... size_rect_x8) and distance
+(the seed's rectangle over a large floor at heights 0.01 ... 10 times its size;
+members distance_h0.01 ... distance_h10). Their scene files are written to
+OUT/scenes/ when the study runs, byte-identical from run to run, so they are
+cached like scene files. See scenes.py for their exact geometry.
+
 Reference images. One reference per scene and depth mode (max depth), shared
 by every strategy, integrator and sampler since they all converge to the same
 image, rendered by the reference configuration: ``--ref-integrator`` (default
@@ -62,7 +72,7 @@ are dropped and run again. ``--fresh`` discards all previous points
 (references stay cached). A results.csv of the earlier format
 (scene,strategy,spp,seed,seconds,rmse,mse,relmse) is read as integrator
 mixture, sampler independent and the scene's max depth (how it was made) and
-rewritten in the new format; a study_state.json of the earlier version is
+rewritten in the new format, as is one without the family columns; a study_state.json of the earlier version is
 carried over likewise.
 
 Sweep order. For every seed and spp, every depth mode and configuration is
@@ -96,8 +106,13 @@ the first selected integrator, sampler and mode when those are not run).
 
 Outputs (in OUT):
     results.csv          scene,strategy,integrator,sampler,max_depth,spp,seed,
-                         seconds,rmse,mse,relmse (max_depth: the value passed
-                         to mcrt, 1 in the direct mode)
+                         seconds,rmse,mse,relmse,family,family_param,
+                         light_solid_angle (max_depth: the value passed
+                         to mcrt, 1 in the direct mode; family and
+                         family_param empty for scene files; the solid angle
+                         (sr) of the scene's first light from the box's centre
+                         (278, 278, 279.5), or for the distance family from the
+                         floor point under the light, empty when not computed)
     tables.md            the markdown tables
     README.md            the report: machine, commit, command line, date,
                          tables, sampler costs and the plots
@@ -108,6 +123,7 @@ Outputs (in OUT):
                          solid-angle per spp)
     samplers.json        raw output of mcrt_bench_samplers
     references/          cached reference images (EXR) and their metadata
+    scenes/              the scene files of the generated families selected
 
 ``--check`` verifies the outputs afterwards (files exist, CSV columns, every
 configuration has its points in every scene and depth mode, RMSE decreasing
@@ -119,7 +135,7 @@ Code (this package; scripts/study.py is the command's entry point and calls
 cli.main):
     config.py       constants, the types (Config, SceneInfo, Settings, ...),
                     the command line and its defaults
-    scenes.py       scene files by name or path
+    scenes.py       scene files by name or path; generated families; solid angles
     mcrt.py         running mcrt: render (with its time), diff
     references.py   reference images and their cache keys
     results.py      results.csv and study_state.json (resuming)
@@ -131,6 +147,7 @@ cli.main):
     check.py        --check
     cli.py          main()
     util.py         hashes, atomic writes, logging, the progress bar
-    tests/          unit tests of the analysis on synthetic data:
+    tests/          unit tests of the analysis on synthetic data, of the cache
+                    keys and of the scene families:
                     .venv/bin/python -m unittest discover -s scripts/mcrt_study/tests -t scripts
 """

@@ -15,9 +15,9 @@ from .config import (
 )
 from .plots import make_efficiency_plots, make_slice_plots
 from .report import build_tables, write_report
-from .results import legacy_max_depths, read_csv, read_state
+from .results import legacy_max_depths, read_csv, read_state, scene_columns_lookup
 from .runner import run_sampler_bench, run_study
-from .scenes import load_scene
+from .scenes import load_scenes
 from .util import format_duration, log
 
 
@@ -31,7 +31,8 @@ def report_only_inputs(settings: Settings, scenes: list[SceneInfo], spp_given: b
     """
     settings.out.mkdir(parents=True, exist_ok=True)
     state_path = settings.out / STATE_JSON
-    rows = read_csv(settings.out / RESULTS_CSV, legacy_max_depths(settings, state_path))
+    rows = read_csv(settings.out / RESULTS_CSV, legacy_max_depths(settings, state_path),
+                    scene_columns_lookup(settings))
     names = {sc.name for sc in scenes}
     mine = [r for r in rows if r["scene"] in names]
     if mine and not spp_given:
@@ -57,7 +58,7 @@ def main(argv: list[str] | None = None) -> int:
     started = datetime.datetime.now(datetime.timezone.utc)
     t0 = time.monotonic()
     log(f"output: {settings.out}")
-    scenes = [load_scene(s, settings) for s in settings.scenes]
+    scenes = load_scenes(settings.scenes, settings)
     if settings.report_only:
         rows = report_only_inputs(settings, scenes, args.spp is not None, args.seeds is not None)
     else:

@@ -16,7 +16,9 @@ REPO_ROOT = Path(__file__).resolve().parent.parent.parent
 SCENES_DIR = REPO_ROOT / "scenes"
 
 CSV_COLUMNS = ["scene", "strategy", "integrator", "sampler", "max_depth", "spp", "seed",
-               "seconds", "rmse", "mse", "relmse"]
+               "seconds", "rmse", "mse", "relmse", "family", "family_param", "light_solid_angle"]
+# The CSV before the scene-family columns: read, then rewritten as CSV_COLUMNS.
+PRE_FAMILY_CSV_COLUMNS = CSV_COLUMNS[:11]
 # The CSV of the earlier, single-integrator study: read, then rewritten as CSV_COLUMNS.
 OLD_CSV_COLUMNS = ["scene", "strategy", "spp", "seed", "seconds", "rmse", "mse", "relmse"]
 STRATEGIES = ["area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle", "auto"]
@@ -59,6 +61,7 @@ TABLES_MD = "tables.md"
 REPORT_MD = "README.md"
 SAMPLERS_JSON = "samplers.json"
 REFERENCES_DIR = "references"
+GENERATED_SCENES_DIR = "scenes"  # OUT/scenes/: the scene files of generated families
 STATE_VERSION = 2
 
 # Files every complete run writes (the per-scene difference plots are added
@@ -128,6 +131,9 @@ class SceneInfo:
     width: int
     height: int
     max_depth: int  # the global mode's: --max-depth, else the scene's, else mcrt's default
+    family: str = ""  # generated family (scenes.FAMILIES), "" for a scene file
+    family_param: float | None = None  # the family's parameter (light area ratio, or h / light size)
+    light_solid_angle: float | None = None  # first light's solid angle (sr) from the scene's centre point
 
     def depth(self, mode: str) -> int:
         """The max depth passed to mcrt in a depth mode (global or direct)."""
@@ -264,8 +270,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, default=None,
                    help="output directory (default: bench/results, or build/study-quick with --quick)")
     p.add_argument("--scenes", nargs="+", default=None,
-                   help="scene names in scenes/ or paths to scene files "
-                   f"(default: {' '.join(DEFAULT_SCENES)})")
+                   help="scene names in scenes/, paths to scene files, generated families "
+                   "(size_rect, size_disk, size_sphere, distance: all their members) or members "
+                   f"(e.g. size_rect_x2, distance_h0.01) (default: {' '.join(DEFAULT_SCENES)})")
     p.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=None,
                    help="light-sampling strategies (default: area solid-angle)")
     p.add_argument("--integrators", nargs="+", choices=INTEGRATORS, default=None,

@@ -341,6 +341,20 @@ def failure_lines(failures: list[Failure]) -> list[str]:
     return lines
 
 
+def scene_lines(scenes: list[SceneInfo]) -> list[str]:
+    """The report's table of scene families and light solid angles (none when no scene has either)."""
+    if not any(sc.family or sc.light_solid_angle is not None for sc in scenes):
+        return []
+    rows = [[sc.name, sc.family or "–", fmt(sc.family_param), fmt(sc.light_solid_angle)] for sc in scenes]
+    return ["### Scenes\n",
+            "Generated families (scene files in `scenes/` of this directory; see "
+            "`scripts/mcrt_study/scenes.py`): size_* — light area relative to the seed's 130×105; "
+            "distance — light height over the floor relative to its size (130). Solid angle (sr) of the "
+            "first light seen from the box's centre (278, 278, 279.5), for the distance family from the "
+            "floor point under the light.\n",
+            md_table(["scene", "family", "parameter", "light solid angle (sr)"], rows, 2)]
+
+
 def write_report(settings: Settings, scenes: list[SceneInfo], tables: str,
                  figures: list[tuple[str, str]], started: datetime.datetime) -> None:
     """Write tables.md and the report README.md (relative links to the plots)."""
@@ -376,6 +390,9 @@ def write_report(settings: Settings, scenes: list[SceneInfo], tables: str,
         "over its renders (every spp and seed), compared with the baseline "
         f"({base.integrator}, {base.sampler}, {base.strategy}) of the same scene and depth mode.",
         f"- Data: [{RESULTS_CSV}]({RESULTS_CSV}) (one row per render), tables also in [{TABLES_MD}]({TABLES_MD}).\n",
+    ]
+    lines += scene_lines(scenes)
+    lines += [
         "### References\n",
         "One reference per scene and depth mode with a seed the sweep does not use, shared by "
         "every configuration (all converge to the same image); the table gives the configuration "

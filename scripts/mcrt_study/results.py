@@ -10,9 +10,9 @@ from typing import Callable
 
 from .config import (
     CSV_COLUMNS, Config, LEGACY_INTEGRATOR, LEGACY_SAMPLER, MCRT_DEFAULT_MAX_DEPTH,
-    OLD_CSV_COLUMNS, Reference, SCENES_DIR, STATE_VERSION, SceneInfo, Settings,
+    OLD_CSV_COLUMNS, PRE_FAMILY_CSV_COLUMNS, Reference, SCENES_DIR, STATE_VERSION, SceneInfo, Settings,
 )
-from .scenes import scene_file_max_depth, scene_path
+from .scenes import family_member, scene_columns, scene_file_max_depth, scene_path
 from .util import log, sha256_json
 
 
@@ -32,7 +32,28 @@ def parse_row(r: dict) -> dict:
     return {"scene": r["scene"], "strategy": r["strategy"], "integrator": r["integrator"],
             "sampler": r["sampler"], "max_depth": int(r["max_depth"]), "spp": int(r["spp"]),
             "seed": int(r["seed"]), "seconds": float(r["seconds"]), "rmse": float(r["rmse"]),
-            "mse": float(r["mse"]), "relmse": float(r["relmse"])}
+            "mse": float(r["mse"]), "relmse": float(r["relmse"]), "family": r.get("family") or "",
+            "family_param": optional_float(r.get("family_param")),
+            "light_solid_angle": optional_float(r.get("light_solid_angle"))}
+
+
+def optional_float(value: object) -> float | None:
+    """A number of the CSV that may be empty (None)."""
+    return None if value is None or value == "" else float(value)
+
+
+def scene_columns_lookup(settings: Settings) -> Callable[[str], dict]:
+    """The family columns (family, family_param, light_solid_angle) of a scene by name, for rows of
+    a CSV written before those columns: from the --scenes file of that name, else scenes/NAME.json,
+    else the generated family member of that name."""
+    paths = {Path(s).stem: scene_path(s) for s in settings.scenes if family_member(s) is None}
+    cache: dict[str, dict] = {}
+
+    def columns(name: str) -> dict:
+        if name not in cache:
+            cache[name] = scene_columns(name, paths.get(name))
+        return cache[name]
+    return columns
 
 
 def legacy_max_depths(settings: Settings, state_path: Path) -> Callable[[str], int]:
@@ -59,13 +80,17 @@ def legacy_max_depths(settings: Settings, state_path: Path) -> Callable[[str], i
     return depth
 
 
-def read_csv(path: Path, legacy_depth: Callable[[str], int]) -> list[dict]:
+def read_csv(path: Path, legacy_depth: Callable[[str], int],
+             columns: Callable[[str], dict] | None = None) -> list[dict]:
     """Rows of the results CSV, typed; [] if there is none.
 
     A CSV of the earlier format (no integrator, sampler, max_depth) is read as
-    integrator mixture, sampler independent, max depth `legacy_depth(scene)`,
-    and rewritten in the current format. Any other header is refused.
+    integrator mixture, sampler independent, max depth `legacy_depth(scene)`;
+    one without the family columns (family, family_param, light_solid_angle)
+    gets them from `columns(scene)` (default: scenes.scene_columns); either is
+    rewritten in the current format. Any other header is refused.
     """
+    columns = columns or scene_columns
     if not path.is_file():
         return []
     with path.open(newline="", encoding="utf-8") as f:
@@ -73,9 +98,15 @@ def read_csv(path: Path, legacy_depth: Callable[[str], int]) -> list[dict]:
         header, raw = reader.fieldnames, list(reader)
     if header == CSV_COLUMNS:
         return [parse_row(r) for r in raw]
+    if header == PRE_FAMILY_CSV_COLUMNS:
+        rows = [{**parse_row(r), **columns(r["scene"])} for r in raw]
+        write_csv(path, rows)
+        log(f"{path.name}: {len(rows)} rows without the scene-family columns read; rewritten "
+            "with the columns " + ",".join(CSV_COLUMNS))
+        return rows
     if header == OLD_CSV_COLUMNS:
-        rows = [parse_row({**r, "integrator": LEGACY_INTEGRATOR, "sampler": LEGACY_SAMPLER,
-                           "max_depth": legacy_depth(r["scene"])}) for r in raw]
+        rows = [{**parse_row({**r, "integrator": LEGACY_INTEGRATOR, "sampler": LEGACY_SAMPLER,
+                              "max_depth": legacy_depth(r["scene"])}), **columns(r["scene"])} for r in raw]
         write_csv(path, rows)
         log(f"{path.name}: {len(rows)} rows of the earlier format read as integrator "
             f"{LEGACY_INTEGRATOR}, sampler {LEGACY_SAMPLER}, the scene's max depth; rewritten "
@@ -99,7 +130,10 @@ def write_csv(path: Path, rows: list[dict]) -> None:
 def format_row(row: dict) -> dict:
     """A row with its numbers printed at full useful precision."""
     return {**{k: row[k] for k in ("scene", "strategy", "integrator", "sampler", "max_depth", "spp", "seed")},
-            **{k: f"{row[k]:.9g}" for k in ("seconds", "rmse", "mse", "relmse")}}
+            **{k: f"{row[k]:.9g}" for k in ("seconds", "rmse", "mse", "relmse")},
+            "family": row.get("family") or "",
+            "family_param": "" if row.get("family_param") is None else f"{row['family_param']:.9g}",
+            "light_solid_angle": "" if row.get("light_solid_angle") is None else f"{row['light_solid_angle']:.9g}"}
 
 
 def append_csv(path: Path, row: dict) -> None:

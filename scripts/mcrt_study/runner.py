@@ -21,8 +21,9 @@ from .mcrt import McrtError, diff, render
 from .references import find_cached_reference, make_reference, reference_strategies
 from .results import (
     append_csv, empty_state, legacy_max_depths, point_key, read_csv, read_state, row_key,
-    scene_run_key, state_key, write_csv,
+    scene_columns_lookup, scene_run_key, state_key, write_csv,
 )
+from .scenes import scene_info_columns
 from .util import Progress, log, sha256_file, write_text_atomic
 
 
@@ -67,7 +68,7 @@ def run_study(settings: Settings, scenes: list[SceneInfo]) -> list[dict]:
     state_path = out / STATE_JSON
     if settings.fresh and csv_path.exists():
         csv_path.unlink()
-    rows = read_csv(csv_path, legacy_max_depths(settings, state_path))
+    rows = read_csv(csv_path, legacy_max_depths(settings, state_path), scene_columns_lookup(settings))
     state = empty_state() if settings.fresh else read_state(state_path)
     binary_hash = sha256_file(settings.mcrt) if settings.mcrt.is_file() else ""
     done = {row_key(r) for r in rows}
@@ -202,7 +203,7 @@ def sweep_scene(sweep: Sweep, scene: SceneInfo, references: dict[int, Reference]
                         image.unlink(missing_ok=True)
                     row = {"scene": scene.name, "strategy": config.strategy, "integrator": config.integrator,
                            "sampler": config.sampler, "max_depth": depth, "spp": spp, "seed": seed,
-                           "seconds": seconds, **errors}
+                           "seconds": seconds, **errors, **scene_info_columns(scene)}
                     append_csv(sweep.csv_path, row)
                     sweep.rows.append(row)
                     sweep.done.add(key)
