@@ -53,6 +53,7 @@ QUICK_REF_SPP = 1024
 QUICK_SIZE = 48
 QUICK_INTEGRATORS = ["mixture", "mis"]
 QUICK_SAMPLERS = ["independent", "sobol"]
+QUICK_STRATEGIES = ["area", "solid-angle", "projected-solid-angle", "auto"]
 QUICK_OUT = REPO_ROOT / "build" / "study-quick"
 
 RESULTS_CSV = "results.csv"
@@ -259,7 +260,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quick", action="store_true",
                    help=f"tiny study: {QUICK_SIZE}x{QUICK_SIZE}, spp {','.join(map(str, QUICK_SPP))}, "
                    f"one seed, integrators {' '.join(QUICK_INTEGRATORS)}, samplers "
-                   f"{' '.join(QUICK_SAMPLERS)}, {QUICK_REF_SPP} spp references, output in "
+                   f"{' '.join(QUICK_SAMPLERS)}, strategies {' '.join(QUICK_STRATEGIES)}, "
+                   f"{QUICK_REF_SPP} spp references, output in "
                    "build/study-quick (each of these can still be overridden)")
     p.add_argument("--mcrt", type=Path, default=REPO_ROOT / "build" / "mcrt",
                    help="mcrt executable (default: build/mcrt)")
@@ -274,7 +276,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "(size_rect, size_disk, size_sphere, distance: all their members) or members "
                    f"(e.g. size_rect_x2, distance_h0.01) (default: {' '.join(DEFAULT_SCENES)})")
     p.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=None,
-                   help="light-sampling strategies (default: area solid-angle)")
+                   help="light-sampling strategies (default: area solid-angle; --quick: "
+                   f"{' '.join(QUICK_STRATEGIES)})")
     p.add_argument("--integrators", nargs="+", choices=INTEGRATORS, default=None,
                    help="integrators (default: all three; --quick: "
                    f"{' '.join(QUICK_INTEGRATORS)})")
@@ -339,7 +342,7 @@ def resolve_settings(args: argparse.Namespace, argv: list[str]) -> Settings:
         bench=bench,
         out=(args.out or (QUICK_OUT if quick else DEFAULT_OUT)).resolve(),
         scenes=args.scenes or list(DEFAULT_SCENES),
-        strategies=args.strategies or list(DEFAULT_STRATEGIES),
+        strategies=args.strategies or list(QUICK_STRATEGIES if quick else DEFAULT_STRATEGIES),
         integrators=args.integrators or list(QUICK_INTEGRATORS if quick else INTEGRATORS),
         samplers=args.samplers or list(QUICK_SAMPLERS if quick else SAMPLERS),
         depths=args.depths or list(DEPTH_MODES),
