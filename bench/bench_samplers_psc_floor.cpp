@@ -59,62 +59,16 @@
 #include "mcrt/core/rng.hpp"
 #include "mcrt/geometry/sphere.hpp"
 #include "mcrt/sampling/projected_spherical_cap.hpp"
+#include "observers.hpp"
 
 namespace {
 
 using mcrt::vec2;
 using mcrt::vec3;
 
-// -------------------------------- the sets of bench_samplers_psc.cpp (copied)
-mcrt::sphere psc_floor_sphere() {
-  mcrt::sphere s{};
-  s.center = vec3(278.0f, 278.0f, 279.5f);
-  s.radius = 65.0f;
-  return s;
-}
-
-struct psc_floor_receiver {
-  vec3 o, n;
-};
-
-enum class psc_floor_mix { both, above, crossing };
-
-std::vector<psc_floor_receiver> psc_floor_receivers(psc_floor_mix m) {
-  const mcrt::sphere sp = psc_floor_sphere();
-  constexpr std::size_t count = 4096;
-  std::vector<psc_floor_receiver> above, cross_up, cross_down;
-  mcrt::pcg32 rng(7, 13);
-  auto unit = [&rng] {
-    for (;;) {
-      const vec3 d{2.0f * rng.uniform() - 1.0f, 2.0f * rng.uniform() - 1.0f, 2.0f * rng.uniform() - 1.0f};
-      const float l2 = glm::dot(d, d);
-      if (l2 <= 1.0f && l2 > 1e-4f) return d / std::sqrt(l2);
-    }
-  };
-  while (above.size() < count || cross_up.size() + cross_down.size() < count) {
-    const vec3 o = sp.center + sp.radius * (1.2f + 4.8f * rng.uniform()) * unit();
-    const vec3 n = unit();
-    const float mu = glm::dot(sp.center - o, n) / sp.radius;
-    if (mu >= 1.0f) {
-      if (above.size() < count) above.push_back({o, n});
-    } else if (mu >= 0.0f) {
-      if (cross_up.size() < 2 * count / 3) cross_up.push_back({o, n});
-    } else if (mu > -1.0f) {
-      if (cross_down.size() < count - 2 * count / 3) cross_down.push_back({o, n});
-    }
-  }
-  std::vector<psc_floor_receiver> cross = cross_up;
-  cross.insert(cross.end(), cross_down.begin(), cross_down.end());
-  if (m == psc_floor_mix::above) return above;
-  if (m == psc_floor_mix::crossing) return cross;
-  std::vector<psc_floor_receiver> out;
-  for (std::size_t i = 0; i < count / 2; ++i) {
-    out.push_back(above[2 * i]);
-    out.push_back(cross[2 * i]);
-  }
-  for (std::size_t i = out.size() - 1; i > 0; --i) std::swap(out[i], out[rng.next_u32() % uint32_t(i + 1)]);
-  return out;
-}
+// The sphere and receiver sets: bench/observers.hpp (shared with bench_samplers_psc.cpp).
+using mcrt::bench::cap_mix;
+using mcrt::bench::sphere_receiver;
 
 // ------------------------------------------------------------ the UG18 port
 // Names in comments are PSCMaps.h's. T = float when timed (double in the
@@ -301,15 +255,15 @@ result sample(const mcrt::sphere& sp, const vec3& o, const vec3& n, vec2 u, Prob
 // ------------------------------------------------------------ the self-check
 // (see the header comment). Empty if all holds, else the first failure.
 std::string ug18_self_check() {
-  const mcrt::sphere sp = psc_floor_sphere();
+  const mcrt::sphere sp = mcrt::bench::psc_sphere();
   const mcrt::sphere_projected_solid_angle_sampler exact{sp};
   mcrt::pcg32 rng(3, 5);
   auto probe = [] {};
   double worst_double = 0.0, worst_float[2] = {0.0, 0.0};
   int crossing = 0, crossing_off = 0, samples = 0, samples_off = 0;  // (the last two: crossing caps)
-  for (const psc_floor_mix m : {psc_floor_mix::crossing, psc_floor_mix::above}) {
-    const std::vector<psc_floor_receiver> rs = psc_floor_receivers(m);
-    const bool above = m == psc_floor_mix::above;
+  for (const cap_mix m : {cap_mix::crossing, cap_mix::above}) {
+    const std::vector<sphere_receiver> rs = mcrt::bench::sphere_receivers(m);
+    const bool above = m == cap_mix::above;
     for (std::size_t i = 0; i < rs.size(); i += 20) {
       const double omega = exact.projected_solid_angle(rs[i].o, rs[i].n);
       const glm::dvec3 w = glm::dvec3(sp.center) - glm::dvec3(rs[i].o), n = glm::normalize(glm::dvec3(rs[i].n));
@@ -361,19 +315,19 @@ std::string ug18_self_check() {
   return {};
 }
 
-void floor_sphere_ug18(benchmark::State& state, psc_floor_mix m) {
+void floor_sphere_ug18(benchmark::State& state, cap_mix m) {
   static const std::string error = ug18_self_check();
   if (!error.empty()) {
     state.SkipWithError(error.c_str());
     return;
   }
-  const mcrt::sphere sp = psc_floor_sphere();
-  const std::vector<psc_floor_receiver> rs = psc_floor_receivers(m);
+  const mcrt::sphere sp = mcrt::bench::psc_sphere();
+  const std::vector<sphere_receiver> rs = mcrt::bench::sphere_receivers(m);
   auto no_probe = [] {};
   mcrt::pcg32 rng(1, 2);
   std::size_t i = 0;
   for (auto _ : state) {
-    const psc_floor_receiver& r = rs[i++ & (rs.size() - 1)];
+    const sphere_receiver& r = rs[i++ & (rs.size() - 1)];
     benchmark::DoNotOptimize(ug18::sample(sp, r.o, r.n, rng.uniform2(), no_probe));
   }
   state.SetItemsProcessed(state.iterations());
@@ -381,7 +335,7 @@ void floor_sphere_ug18(benchmark::State& state, psc_floor_mix m) {
   long evals = 0, newton = 0, samples = 8 * long(rs.size());
   rng = mcrt::pcg32(1, 2);
   for (long k = 0; k < samples; ++k) {
-    const psc_floor_receiver& r = rs[std::size_t(k) & (rs.size() - 1)];
+    const sphere_receiver& r = rs[std::size_t(k) & (rs.size() - 1)];
     long here = 0;
     auto count = [&here] { ++here; };
     ug18::sample(sp, r.o, r.n, rng.uniform2(), count);
@@ -392,9 +346,9 @@ void floor_sphere_ug18(benchmark::State& state, psc_floor_mix m) {
   state.counters["newton_share"] = double(newton) / double(samples);
 }
 
-void BM_FloorSphereUG18(benchmark::State& st) { floor_sphere_ug18(st, psc_floor_mix::both); }
-void BM_FloorSphereUG18Above(benchmark::State& st) { floor_sphere_ug18(st, psc_floor_mix::above); }
-void BM_FloorSphereUG18Crossing(benchmark::State& st) { floor_sphere_ug18(st, psc_floor_mix::crossing); }
+void BM_FloorSphereUG18(benchmark::State& st) { floor_sphere_ug18(st, cap_mix::both); }
+void BM_FloorSphereUG18Above(benchmark::State& st) { floor_sphere_ug18(st, cap_mix::above); }
+void BM_FloorSphereUG18Crossing(benchmark::State& st) { floor_sphere_ug18(st, cap_mix::crossing); }
 BENCHMARK(BM_FloorSphereUG18);
 BENCHMARK(BM_FloorSphereUG18Above);
 BENCHMARK(BM_FloorSphereUG18Crossing);

@@ -420,7 +420,14 @@ inline int clip(const rect& r, const vec3& o, const frame& f, vec3 (&v)[max_vert
 }  // namespace peters21
 
 // sample + pdf of Peters 2021 as published (see above) on the observers.
-template <normals N>
+// With charge_pdf (BM_RectPSA_FloorPeters21WithPdf) the pdf of the sampled
+// direction is charged as a second call from the same receiver would pay it,
+// as the library's pdf() does: the clip and the polygon's set-up again (its
+// projected solid angle), then cos / Omega_proj. Not the published usage (a
+// shader prepares once per shading point and reuses the set-up for the light
+// sample and the BSDF direction's pdf), but the like-for-like counterpart of
+// sample() + pdf() through a stateless interface.
+template <normals N, bool charge_pdf>
 void BM_RectPSA_FloorPeters21(benchmark::State& state) {
   const rect light = bench::cornell_rect_light();
   const std::vector<vec3> obs = bench::observers_around(light);
@@ -435,51 +442,24 @@ void BM_RectPSA_FloorPeters21(benchmark::State& state) {
     if (count == 0) continue;
     const peters21::polygon p = peters21::prepare(count, v);
     const vec3 local = peters21::sample(p, rng.uniform2());
-    const float pdf = local.z / p.psa;
     const vec3 dir = f.to_world(local);
     benchmark::DoNotOptimize(dir);
-    benchmark::DoNotOptimize(pdf);
+    if constexpr (charge_pdf) {
+      const peters21::frame f2(ns[k]);
+      vec3 v2[peters21::max_vertices];
+      const int count2 = peters21::clip(light, obs[k], f2, v2);
+      if (count2 == 0) continue;
+      const peters21::polygon p2 = peters21::prepare(count2, v2);
+      benchmark::DoNotOptimize(glm::dot(dir, ns[k]) / p2.psa);
+    } else {
+      benchmark::DoNotOptimize(local.z / p.psa);
+    }
   }
   state.SetItemsProcessed(state.iterations());
 }
-BENCHMARK(BM_RectPSA_FloorPeters21<normals::up>)->Name("BM_RectPSA_FloorPeters21/Up");
-BENCHMARK(BM_RectPSA_FloorPeters21<normals::random>)->Name("BM_RectPSA_FloorPeters21/Random");
-
-// The same with the pdf of the sampled direction charged as a second call
-// from the same receiver would pay it, as the library's pdf() does: the
-// clip and the polygon's set-up again (its projected solid angle), then
-// cos / Omega_proj. Not the published usage (a shader prepares once per
-// shading point and reuses the set-up for the light sample and the BSDF
-// direction's pdf), but the like-for-like counterpart of sample() + pdf()
-// through a stateless interface.
-template <normals N>
-void BM_RectPSA_FloorPeters21WithPdf(benchmark::State& state) {
-  const rect light = bench::cornell_rect_light();
-  const std::vector<vec3> obs = bench::observers_around(light);
-  const std::vector<vec3> ns = receiver_normals(light, obs, N);
-  pcg32 rng(1, 2);
-  std::size_t i = 0;
-  for (auto _ : state) {
-    const std::size_t k = i++ & (obs.size() - 1);
-    const peters21::frame f(ns[k]);
-    vec3 v[peters21::max_vertices];
-    const int count = peters21::clip(light, obs[k], f, v);
-    if (count == 0) continue;
-    const peters21::polygon p = peters21::prepare(count, v);
-    const vec3 local = peters21::sample(p, rng.uniform2());
-    const vec3 dir = f.to_world(local);
-    benchmark::DoNotOptimize(dir);
-    const peters21::frame f2(ns[k]);
-    vec3 v2[peters21::max_vertices];
-    const int count2 = peters21::clip(light, obs[k], f2, v2);
-    if (count2 == 0) continue;
-    const peters21::polygon p2 = peters21::prepare(count2, v2);
-    const float pdf = glm::dot(dir, ns[k]) / p2.psa;
-    benchmark::DoNotOptimize(pdf);
-  }
-  state.SetItemsProcessed(state.iterations());
-}
-BENCHMARK(BM_RectPSA_FloorPeters21WithPdf<normals::up>)->Name("BM_RectPSA_FloorPeters21WithPdf/Up");
-BENCHMARK(BM_RectPSA_FloorPeters21WithPdf<normals::random>)->Name("BM_RectPSA_FloorPeters21WithPdf/Random");
+BENCHMARK(BM_RectPSA_FloorPeters21<normals::up, false>)->Name("BM_RectPSA_FloorPeters21/Up");
+BENCHMARK(BM_RectPSA_FloorPeters21<normals::random, false>)->Name("BM_RectPSA_FloorPeters21/Random");
+BENCHMARK(BM_RectPSA_FloorPeters21<normals::up, true>)->Name("BM_RectPSA_FloorPeters21WithPdf/Up");
+BENCHMARK(BM_RectPSA_FloorPeters21<normals::random, true>)->Name("BM_RectPSA_FloorPeters21WithPdf/Random");
 
 }  // namespace

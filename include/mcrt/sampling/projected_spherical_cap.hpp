@@ -131,6 +131,7 @@
 #include <numbers>
 
 #include "mcrt/core/fast_math.hpp"
+#include "mcrt/core/onb.hpp"
 #include "mcrt/geometry/sphere.hpp"
 #include "mcrt/sampling/light_sample.hpp"
 
@@ -576,9 +577,7 @@ struct projected_cap_above {
     if (roots[3] > 0.0f) {
       ex = vec3(pn) * inv[2];
     } else {  // axis along the normal: any x will do (the ellipse is a circle about the origin)
-      const float sign = std::copysign(1.0f, ez.z);
-      const float a = -1.0f / (sign + ez.z), b = ez.x * ez.y * a;
-      ex = vec3(1.0f + sign * ez.x * ez.x * a, sign * b, -sign * ez.x);
+      ex = onb(ez).u;
     }
     ey = glm::cross(ez, ex);
     return true;
