@@ -17,7 +17,8 @@ namespace mcrt {
 
 namespace fast_math {
 
-// atan2(y, x) for y >= 0, in [0, pi], to a few ulp of double (relative),
+// atan2(y, x) for y >= 0, in [0, pi], to 5e-15 relative (the fit's bound;
+// under 10 ulp measured, tests/test_fast_math.cpp),
 // without a branch or a libm call: the reductions of Cephes' atan (S. L.
 // Moshier, "Methods and Programs for Mathematical Functions", 1989), t =
 // a / b -> 1/t and t -> (t - 1)/(t + 1) down to |t| <= tan(pi/8), selected
@@ -53,7 +54,8 @@ inline double atan2_upper(double y, double x) {
 // its relative precision for small a), without a branch or a libm call:
 // s = a + a z S(z), c = 1 + z C(z), z = a^2, S and C of degree 6 Chebyshev
 // fits on [0, (pi/2)^2] (mpmath.chebyfit, 40 digits; relative errors below
-// 5e-16 and 8e-15), evaluated by Estrin's scheme.
+// 5e-16 and 8e-15), evaluated by Estrin's scheme. Measured: sin within 1e-15
+// relative, cos within 8e-15 absolute (tests/test_fast_math.cpp).
 inline void sincos_quadrant(double a, double& s, double& c) {
   const double z = a * a, z2 = z * z, z4 = z2 * z2;
   const double s01 = -0.16666666666666648035 + 0.0083333333333259326765 * z;
