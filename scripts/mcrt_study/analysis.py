@@ -206,3 +206,117 @@ def crossovers(x, ratio) -> list[float]:
                 found.append(float(x[last + 1]))
         last = i
     return found
+
+
+# --------------------------------------------------------------------------
+# Scene families: each strategy's efficiency over area sampling against the
+# light's solid angle, and where it crosses 1.
+# --------------------------------------------------------------------------
+
+FAMILY_PARAM_LABELS = {"size_rect": "light area / seed's", "size_disk": "light area / seed's",
+                       "size_sphere": "projected area / seed's", "distance": "h / light size"}
+
+
+def family_param_label(family: str) -> str:
+    """What a family's parameter is, for axes and tables."""
+    return FAMILY_PARAM_LABELS.get(family, "family parameter")
+
+
+def run_families(scenes: list[SceneInfo]) -> dict[str, list[SceneInfo]]:
+    """The generated families of this run's scenes (first appearance order), each with its members
+    that have a light solid angle, in increasing solid angle."""
+    families: dict[str, list[SceneInfo]] = {}
+    for sc in scenes:
+        if sc.family and sc.light_solid_angle is not None and sc.light_solid_angle > 0:
+            families.setdefault(sc.family, []).append(sc)
+    return {f: sorted(m, key=lambda sc: sc.light_solid_angle) for f, m in families.items()}
+
+
+def ratio_with_se(per: dict, base: Config, config: Config) -> tuple[float, float]:
+    """A configuration's efficiency over the baseline's in one (scene, depth) of analyse_configs,
+    and the standard error of its log (nan when either efficiency lacks one): the two
+    geometric means' log standard errors added in quadrature."""
+    if config not in per or base not in per:
+        return float("nan"), float("nan")
+    a, b = per[config], per[base]
+    ratio = a["efficiency"] / b["efficiency"] if b["efficiency"] > 0 else float("nan")
+    se = [math.log1p(x["rel_se"]) for x in (a, b)]
+    return ratio, (math.hypot(*se) if all(math.isfinite(s) for s in se) else float("nan"))
+
+
+def family_series(analysis: dict, members: list[SceneInfo], mode: str, base: Config, config: Config) -> dict:
+    """One strategy's efficiency over area sampling across a family's members (in the order given),
+    in one depth mode: solid angles, family parameters, ratios and the ratios' log standard
+    errors (lists; members without points left out)."""
+    series: dict[str, list] = {"scene": [], "solid_angle": [], "param": [], "ratio": [], "log_se": []}
+    for sc in members:
+        per = analysis.get((sc.name, sc.depth(mode)), {})
+        ratio, se = ratio_with_se(per, base, config)
+        if not math.isfinite(ratio):
+            continue
+        series["scene"].append(sc.name)
+        series["solid_angle"].append(float(sc.light_solid_angle))
+        series["param"].append(float(sc.family_param) if sc.family_param is not None else float("nan"))
+        series["ratio"].append(ratio)
+        series["log_se"].append(se)
+    return series
+
+
+def crossover_verdict(x, ratio) -> tuple[list[float], str]:
+    """The crossings of 1 (analysis.crossovers) and a word for a series without one: 'always
+    above' or 'always below' (every point on one side of 1), 'none in range' (it touches 1 without
+    crossing), 'no points'. The word is '' when there are crossings."""
+    import numpy as np
+
+    found = crossovers(x, ratio)
+    if found:
+        return found, ""
+    x, r = np.asarray(x, float), np.asarray(ratio, float)
+    r = r[np.isfinite(r) & np.isfinite(x) & (x > 0)]
+    if not len(r):
+        return [], "no points"
+    if np.all(r > 1):
+        return [], "always above"
+    if np.all(r < 1):
+        return [], "always below"
+    return [], "none in range"
+
+
+def interp_param(solid_angle: float, solid_angles, params) -> float:
+    """The family parameter at a solid angle, interpolated linearly in log-log between the members
+    (nan outside them, or when a parameter is missing)."""
+    import numpy as np
+
+    x, p = np.asarray(solid_angles, float), np.asarray(params, float)
+    if not np.all(np.isfinite(p) & (p > 0)):
+        return float("nan")
+    return interp_loglog(solid_angle, x, p)
+
+
+def family_crossovers(analysis: dict, settings: Settings, scenes: list[SceneInfo]) -> list[dict]:
+    """Per family of the run, depth mode, integrator, sampler and strategy other than area (area
+    of the same integrator and sampler the baseline): its series (family_series), crossings of 1
+    in solid angle with the family parameter there, and the verdict (crossover_verdict).
+
+    Empty when area sampling is not among the strategies.
+    """
+    if "area" not in settings.strategies:
+        return []
+    found = []
+    for family, members in run_families(scenes).items():
+        for mode in settings.depths:
+            for integrator in settings.integrators:
+                for sampler in settings.samplers:
+                    base = Config("area", integrator, sampler)
+                    for strategy in settings.strategies:
+                        if strategy == "area":
+                            continue
+                        series = family_series(analysis, members, mode, base, Config(strategy, integrator, sampler))
+                        crossings, verdict = crossover_verdict(series["solid_angle"], series["ratio"])
+                        found.append({
+                            "family": family, "mode": mode, "integrator": integrator, "sampler": sampler,
+                            "strategy": strategy, "series": series, "crossings": crossings,
+                            "params": [interp_param(c, series["solid_angle"], series["param"]) for c in crossings],
+                            "verdict": verdict,
+                        })
+    return found

@@ -223,3 +223,112 @@ def make_efficiency_plots(analysis: dict, settings: Settings,
                               "error (whiskers, from the spread over seeds), the baseline (dashed) and the "
                               "best configuration (★). Higher is better."))
     return figures
+
+
+def densify(x, y, steps: int = 24):
+    """A polyline through (x, y) with `steps` points per segment, evenly spaced in log x and
+    linear in y between the given points (x positive and increasing)."""
+    import numpy as np
+
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    if len(x) < 2:
+        return x, y
+    t = np.linspace(0.0, 1.0, steps, endpoint=False)
+    lx = np.log(x)
+    xs = [np.exp(lx[i] + t * (lx[i + 1] - lx[i])) for i in range(len(x) - 1)]
+    ys = [y[i] + t * (y[i + 1] - y[i]) for i in range(len(x) - 1)]
+    return np.concatenate([*xs, x[-1:]]), np.concatenate([*ys, y[-1:]])
+
+
+def family_figure_name(family: str, mode: str) -> str:
+    """The file of a family's crossover figure in a depth mode."""
+    return f"family_{family}_{mode}.png"
+
+
+def make_family_plots(found: list[dict], settings: Settings) -> list[tuple[str, str]]:
+    """One figure per scene family and depth mode (from analysis.family_crossovers): per integrator
+    and sampler, each strategy's efficiency over area sampling against the light's solid angle (log
+    x; band: ± one standard error where the analysis has one), the line at 1, and the crossings of
+    1 marked with their solid angle; the top axis gives the family parameter of the members.
+    Returns (file name, caption) pairs."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import matplotlib.ticker as ticker
+    import numpy as np
+
+    from .analysis import family_param_label
+
+    figures: list[tuple[str, str]] = []
+    for family, mode in dict.fromkeys((f["family"], f["mode"]) for f in found):
+        mine = [f for f in found if (f["family"], f["mode"]) == (family, mode) and f["series"]["ratio"]]
+        groups = list(dict.fromkeys((f["integrator"], f["sampler"]) for f in mine))
+        if not groups:
+            continue
+        cols = min(3, len(groups))
+        nrows = (len(groups) + cols - 1) // cols
+        fig, axes = plt.subplots(nrows, cols, figsize=(5.6 * cols, 4.4 * nrows), squeeze=False)
+        for ax in axes.flat[len(groups):]:
+            ax.set_visible(False)
+        for ax, (integrator, sampler) in zip(axes.flat, groups):
+            members: dict[float, float] = {}
+            for f in mine:
+                if (f["integrator"], f["sampler"]) != (integrator, sampler):
+                    continue
+                s = f["series"]
+                order = np.argsort(s["solid_angle"])
+                x = np.asarray(s["solid_angle"])[order]
+                r = np.asarray(s["ratio"])[order]
+                se = np.asarray(s["log_se"])[order]
+                members.update(zip(s["solid_angle"], s["param"]))
+                style = STRATEGY_STYLE.get(f["strategy"], {"color": None, "label": f["strategy"]})
+                # Between members the ratio is drawn as the crossings are found: linear in the
+                # ratio against log solid angle (a curve on these log axes).
+                xd, rd = densify(x, r)
+                line, = ax.plot(xd, rd, color=style["color"], label=style["label"])
+                ax.plot(x, r, "o", ms=4, color=line.get_color())
+                if np.any(np.isfinite(se)):
+                    band = np.where(np.isfinite(se), se, 0.0)
+                    _, lo = densify(x, r * np.exp(-band))
+                    _, hi = densify(x, r * np.exp(band))
+                    ax.fill_between(xd, lo, hi, color=line.get_color(), alpha=0.18, linewidth=0)
+                for c in f["crossings"]:
+                    ax.axvline(c, color=line.get_color(), ls=":", lw=0.9)
+                    ax.plot([c], [1.0], marker="D", ms=7, mfc="white", mec=line.get_color(), mew=1.6, zorder=5)
+                    ax.annotate(f"{c:.3g} sr", (c, 1.0), xytext=(5, -13), textcoords="offset points",
+                                fontsize=8, color=line.get_color(), zorder=6,
+                                bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8})
+            ax.axhline(1.0, color="k", lw=0.9)
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.yaxis.set_major_locator(ticker.LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+            ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+            ax.yaxis.set_minor_formatter(ticker.NullFormatter())
+            ax.set_xlabel("light solid angle (sr)")
+            ax.set_ylabel("efficiency / area sampling's")
+            ax.set_title(f"{integrator}, {sampler}", fontsize=10)
+            ax.grid(True, which="both", alpha=0.3)
+            ax.legend(fontsize=7)
+            # The members' family parameter on a top axis at their solid angles.
+            known = {x: p for x, p in members.items() if math.isfinite(p)}
+            if known:
+                top = ax.twiny()
+                top.set_xscale("log")
+                top.set_xlim(ax.get_xlim())
+                top.set_xticks(sorted(known))
+                top.set_xticklabels([f"{known[x]:g}" for x in sorted(known)], fontsize=7)
+                top.xaxis.set_minor_locator(ticker.NullLocator())
+                top.set_xlabel(family_param_label(family), fontsize=8)
+        what = "global illumination" if mode == "global" else "direct lighting"
+        fig.suptitle(f"{family}, {what}:\nefficiency over area sampling against the light's solid angle",
+                     fontsize=11)
+        fig.tight_layout()
+        name = family_figure_name(family, mode)
+        fig.savefig(settings.out / name, dpi=110)
+        plt.close(fig)
+        figures.append((name, f"{family}, {mode} depth mode: each strategy's efficiency 1/(MSE·time) over "
+                              "area sampling's (same integrator and sampler) against the solid angle of the "
+                              f"light (log axes; top axis: {family_param_label(family)}); band: ± one standard "
+                              "error; diamonds: where a strategy crosses area sampling (above 1: better)."))
+    return figures

@@ -420,8 +420,48 @@ def write_report(settings: Settings, scenes: list[SceneInfo], tables: str,
         lines.append("")
     lines.append("## Results\n")
     lines.append(tables)
+    # Figures the tables already show (scene families, pixel maps) are not repeated.
+    figures = [(name, caption) for name, caption in figures if f"]({name})" not in tables]
     if figures:
         lines.append("\n## Plots\n")
         for name, caption in figures:
             lines.append(f"![{name}]({name})\n\n{caption}\n")
     write_text_atomic(out / REPORT_MD, "\n".join(lines) + "\n")
+
+
+def crossover_cell(entry: dict) -> str:
+    """The crossings of one family series, with the family parameter there, or its verdict."""
+    if not entry["crossings"]:
+        return entry["verdict"]
+    return "; ".join(f"{fmt(c, 3)} sr" + (f" ({fmt(p, 3)})" if math.isfinite(p) else "")
+                     for c, p in zip(entry["crossings"], entry["params"]))
+
+
+def family_section(found: list[dict], figures: list[tuple[str, str]]) -> str:
+    """The report's section on scene families (from analysis.family_crossovers): the crossover
+    table and the figures (plots.make_family_plots). Empty when the run has no family."""
+    if not found:
+        return ""
+    from .analysis import family_param_label
+
+    parts = [
+        "\n## Scene families: crossovers\n\n"
+        "Each strategy's efficiency over area sampling (same integrator, sampler and depth mode) on "
+        "every member of a generated family, against the solid angle of the light (see Scenes). A "
+        "crossover is where the ratio crosses 1, interpolated linearly in the ratio against log solid "
+        "angle between neighbouring members; in brackets the family parameter there (log-log "
+        "interpolation). Without one: always above (the strategy beats area sampling on every "
+        "member), always below, none in range (it touches 1 without crossing), or no points.\n\n"]
+    rows = []
+    for f in found:
+        r = f["series"]["ratio"]
+        span = f"{fmt(min(r), 3)} – {fmt(max(r), 3)}" if r else "–"
+        rows.append([f["family"], f"{f['mode']}, {f['integrator']}, {f['sampler']}", f["strategy"],
+                     str(len(r)), span, crossover_cell(f)])
+    parts.append(md_table(["family", "slice (depth, integrator, sampler)", "strategy", "members",
+                           "ratio range", "crossover solid angle (parameter)"], rows, 3))
+    families = list(dict.fromkeys(f["family"] for f in found))
+    parts.append("\nParameters: " + "; ".join(f"{fam}: {family_param_label(fam)}" for fam in families) + ".\n")
+    for name, caption in figures:
+        parts.append(f"\n![{name}]({name})\n\n{caption}\n")
+    return "".join(parts)
