@@ -51,6 +51,13 @@ times (projected) area; members size_rect_1of16 ... size_rect_x8) and distance
 members distance_h0.01 ... distance_h10). Their scene files are written to
 OUT/scenes/ when the study runs, byte-identical from run to run, so they are
 cached like scene files. See scenes.py for their exact geometry.
+With a family among the scenes the report plots, per family and depth mode,
+each strategy's efficiency over area sampling against the light's solid
+angle and tabulates where it crosses 1 (family_<family>_<mode>.png).
+``--pixel-maps SCENE ...`` (default none) adds per-pixel efficiency maps
+against area sampling, ``--pixel-map-seeds`` renders (default 8) at
+``--pixel-map-spp`` (default the sweep's largest) per strategy in the report's
+slice (pixelmaps.py; pixelmap_<scene>_<mode>.png and .npz).
 
 Reference images. One reference per scene and depth mode (max depth), shared
 by every strategy, integrator and sampler since they all converge to the same

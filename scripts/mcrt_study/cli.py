@@ -68,14 +68,17 @@ def main(argv: list[str] | None = None) -> int:
     tables, summary, analysis = build_tables(selected, settings, scenes, samplers)
     figures = make_efficiency_plots(analysis, settings, scene_panels(scenes, settings))
     figures += make_slice_plots(slice_rows(selected, settings, scenes), settings, [sc.name for sc in scenes])
-    # Scene families: efficiency over area sampling against the light's solid angle, crossovers.
+    # Scene families (efficiency over area sampling against the light's solid angle, crossovers)
+    # and the per-pixel efficiency maps of --pixel-maps: sections of the tables and report.
     from .analysis import family_crossovers
+    from .pixelmaps import make_pixel_maps, pixel_map_figures, pixel_map_section
     from .plots import make_family_plots
     from .report import family_section
     crossings = family_crossovers(analysis, settings, scenes)
     family_figures = make_family_plots(crossings, settings)
-    tables += family_section(crossings, family_figures)
-    figures += family_figures
+    maps = make_pixel_maps(settings)
+    tables += family_section(crossings, family_figures) + pixel_map_section(maps)
+    figures += family_figures + pixel_map_figures(maps)
     write_report(settings, scenes, tables, figures, started)
     log(f"done in {format_duration(time.monotonic() - t0)}: {settings.out / REPORT_MD}")
     ok = not [f for f in settings.failures if not f.unavailable]

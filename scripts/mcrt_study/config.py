@@ -217,6 +217,10 @@ class Settings:
     check: bool
     command_line: str
     failures: list[Failure] = field(default_factory=list)
+    # Per-pixel efficiency maps (scripts/mcrt_study/pixelmaps.py).
+    pixel_maps: list[str] = field(default_factory=list)  # scenes to map; none by default
+    pixel_map_seeds: int = 8
+    pixel_map_spp: int | None = None  # None: the sweep's largest spp
 
     @property
     def configs(self) -> list[Config]:
@@ -326,6 +330,13 @@ def build_parser() -> argparse.ArgumentParser:
                    help="render nothing: rebuild tables, plots and report from the CSV")
     p.add_argument("--check", action="store_true",
                    help="verify the outputs at the end; exit 1 if a check fails")
+    p.add_argument("--pixel-maps", nargs="+", default=None, metavar="SCENE",
+                   help="per-pixel efficiency maps against area sampling for these scenes (names as for "
+                   "--scenes), in the report's slice (integrator, sampler, depth mode) (default: none)")
+    p.add_argument("--pixel-map-seeds", type=int, default=8,
+                   help="renders (seeds) per strategy of each pixel map (default: 8)")
+    p.add_argument("--pixel-map-spp", type=int, default=None,
+                   help="samples per pixel of the pixel maps' renders (default: the sweep's largest)")
     return p
 
 
@@ -391,6 +402,10 @@ def resolve_settings(args: argparse.Namespace, argv: list[str]) -> Settings:
         problems.append("--budgets must be positive")
     if not settings.report_only and not (settings.mcrt.is_file() and os.access(settings.mcrt, os.X_OK)):
         problems.append(f"mcrt executable not found: {settings.mcrt} (build it, or pass --mcrt)")
+    settings.pixel_maps = list(dict.fromkeys(args.pixel_maps or []))
+    settings.pixel_map_seeds, settings.pixel_map_spp = args.pixel_map_seeds, args.pixel_map_spp
+    if settings.pixel_map_seeds < 1 or (settings.pixel_map_spp is not None and settings.pixel_map_spp < 1):
+        problems.append("--pixel-map-seeds and --pixel-map-spp must be positive")
     if problems:
         raise SystemExit("study.py: " + "; ".join(problems))
     return settings
