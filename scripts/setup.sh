@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what mcrt needs on a fresh Debian 12 machine, and nothing that is
 # already there: the compiler and CMake, the libraries (Debian packages) and
-# a Python virtual environment .venv with the study's plotting packages.
+# a Python virtual environment .venv with the study's packages (plots, Dask).
 # Safe to run again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,9 +20,10 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-# Python for scripts/ (the error-vs-time study and its plots).
-if [ ! -x .venv/bin/python ] || ! .venv/bin/python -c "import numpy, matplotlib" 2>/dev/null; then
-  echo "setup: creating .venv with scripts/requirements.txt" >&2
-  python3 -m venv .venv
-  .venv/bin/pip install -q --disable-pip-version-check -r scripts/requirements.txt
+# Python for scripts/ (the error-vs-time study, its plots and its Dask backend).
+# An existing .venv that lacks a package is upgraded in place.
+if [ ! -x .venv/bin/python ] || ! .venv/bin/python -c "import numpy, matplotlib, distributed" 2>/dev/null; then
+  echo "setup: installing scripts/requirements.txt into .venv" >&2
+  [ -x .venv/bin/python ] || python3 -m venv .venv
+  .venv/bin/pip install -q --disable-pip-version-check --upgrade -r scripts/requirements.txt
 fi

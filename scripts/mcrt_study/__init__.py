@@ -70,8 +70,12 @@ integrator and sampler (``--ref-key-binary`` adds a hash of the mcrt binary),
 so they are rendered once; a reference made by mixture + independent has the
 key of the earlier, single-integrator study, whose cache stays valid.
 
-Resuming. Every finished point is appended to OUT/results.csv at once; a run
-skips the points already there (a point is scene, strategy, integrator,
+Resuming. Every finished point is written at once as its own file,
+OUT/points/<hash>.json (by whichever process rendered it, through a temporary
+name and a rename, so never half-written), and appended to OUT/results.csv;
+a run, and --report-only, first merge into the CSV the point files it lacks
+(those made with the settings study_state.json records), so a crashed or
+killed run loses no finished point. A run skips the points already there (a point is scene, strategy, integrator,
 sampler, max depth, spp, seed). OUT/study_state.json remembers, per scene and
 max depth, the settings the points were made with (scene content, resolution,
 max depth, reference): when those change, the points of that scene and depth
@@ -86,6 +90,17 @@ Sweep order. For every seed and spp, every depth mode and configuration is
 rendered in turn (the order of the configurations rotated from one point to
 the next), so that a drift of the machine's speed affects all configurations
 alike.
+
+Where the renders run. References are rendered by the command itself, one at
+a time, before a scene's sweep. The sweep's points run on an executor:
+``--jobs 1`` (default) one after another in this process; ``--jobs N`` a pool
+of N local processes, each render with --threads max(1, cores // N) unless
+--threads is given; ``--backend dask --scheduler tcp://HOST:8786`` the workers
+of a Dask distributed cluster, which need the mcrt binary at the same path and
+OUT on shared storage (see executors.py). Rows enter the CSV in the sweep's
+order whatever order the points finish in. Concurrent renders share the
+machine; equal-time comparisons stay fair because the configurations are
+rotated, so that each runs alongside the others alike.
 
 Unavailable strategies. A configuration that mcrt rejects as "not available
 in this build" (exit status 2) is skipped for that scene and named in the
@@ -147,6 +162,10 @@ cli.main):
     references.py   reference images and their cache keys
     results.py      results.csv and study_state.json (resuming)
     runner.py       the sweep, and the sampler benchmark
+    executors.py    where the sweep's points run: this process, a local process
+                    pool, a Dask cluster (--jobs, --backend, --scheduler)
+    points.py       one point on a worker (render, diff) and its point file;
+                    merging point files into results.csv
     analysis.py     efficiency, standard errors, equal-time interpolation,
                     convergence slopes, crossovers (pure; no files)
     report.py       markdown tables and README.md
@@ -155,6 +174,7 @@ cli.main):
     cli.py          main()
     util.py         hashes, atomic writes, logging, the progress bar
     tests/          unit tests of the analysis on synthetic data, of the cache
-                    keys and of the scene families:
+                    keys, of the scene families and of the sweep on its
+                    executors with point files (a fake render, no mcrt):
                     .venv/bin/python -m unittest discover -s scripts/mcrt_study/tests -t scripts
 """

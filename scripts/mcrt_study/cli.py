@@ -13,7 +13,9 @@ from .config import (
     Config, Failure, REPORT_MD, RESULTS_CSV, STATE_JSON, SceneInfo, Settings, build_parser,
     resolve_settings,
 )
+from .executors import add_arguments, backend_of
 from .plots import make_efficiency_plots, make_slice_plots
+from .points import POINTS_DIR, merge_point_files
 from .report import build_tables, write_report
 from .results import legacy_max_depths, read_csv, read_state, scene_columns_lookup
 from .runner import run_sampler_bench, run_study
@@ -23,7 +25,8 @@ from .util import format_duration, log
 
 def report_only_inputs(settings: Settings, scenes: list[SceneInfo], spp_given: bool,
                        seeds_given: bool) -> list[dict]:
-    """For --report-only: the CSV's rows and the failures recorded in the state file.
+    """For --report-only: the CSV's rows (with the point files merged in) and the failures recorded
+    in the state file.
 
     Without --spp or --seeds, the report covers the spp values and seeds the
     CSV holds for the selected scenes (so an earlier run's report can be
@@ -31,8 +34,10 @@ def report_only_inputs(settings: Settings, scenes: list[SceneInfo], spp_given: b
     """
     settings.out.mkdir(parents=True, exist_ok=True)
     state_path = settings.out / STATE_JSON
-    rows = read_csv(settings.out / RESULTS_CSV, legacy_max_depths(settings, state_path),
-                    scene_columns_lookup(settings))
+    csv_path = settings.out / RESULTS_CSV
+    state = read_state(state_path)
+    rows = read_csv(csv_path, legacy_max_depths(settings, state_path), scene_columns_lookup(settings))
+    rows = merge_point_files(csv_path, rows, settings.out / POINTS_DIR, state)
     names = {sc.name for sc in scenes}
     mine = [r for r in rows if r["scene"] in names]
     if mine and not spp_given:
@@ -41,7 +46,7 @@ def report_only_inputs(settings: Settings, scenes: list[SceneInfo], spp_given: b
         settings.seeds = sorted({r["seed"] for r in mine})
     depths = {sc.name: {d for _, d in sc.depth_modes(settings.depths)} for sc in scenes}
     configs = set(settings.configs)
-    failures = [Failure(**f) for f in read_state(state_path).get("failures", [])]
+    failures = [Failure(**f) for f in state.get("failures", [])]
     settings.failures = [f for f in failures if f.scene in names
                          and Config(f.strategy, f.integrator, f.sampler) in configs
                          and (f.max_depth is None or f.max_depth in depths[f.scene])]
@@ -53,8 +58,11 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv if argv is None else argv
     # Stop cleanly (temporary images removed, finished points kept) on SIGTERM too.
     signal.signal(signal.SIGTERM, lambda *_: (_ for _ in ()).throw(KeyboardInterrupt()))
-    args = build_parser().parse_args(argv[1:])
+    parser = build_parser()
+    add_arguments(parser)
+    args = parser.parse_args(argv[1:])
     settings = resolve_settings(args, argv)
+    backend = backend_of(args)
     started = datetime.datetime.now(datetime.timezone.utc)
     t0 = time.monotonic()
     log(f"output: {settings.out}")
@@ -62,7 +70,7 @@ def main(argv: list[str] | None = None) -> int:
     if settings.report_only:
         rows = report_only_inputs(settings, scenes, args.spp is not None, args.seeds is not None)
     else:
-        rows = run_study(settings, scenes)
+        rows = run_study(settings, scenes, backend)
     samplers = run_sampler_bench(settings)
     selected = select_rows(rows, settings, scenes)
     tables, summary, analysis = build_tables(selected, settings, scenes, samplers)

@@ -6,9 +6,11 @@ import dataclasses
 import itertools
 import json
 import os
+import queue
 import shutil
 import subprocess
 import tempfile
+from concurrent.futures import Future
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,7 +19,11 @@ from .config import (
     RESULTS_CSV, Reference, SAMPLERS_JSON, SAMPLER_DESCRIPTIONS, STATE_JSON, STRATEGY_COST,
     SceneInfo, Settings, config_of,
 )
-from .mcrt import McrtError, diff, render
+from .executors import Backend, Pool, machine_cores, open_pool, render_threads
+from .mcrt import McrtError
+from .points import (
+    POINTS_DIR, Measure, PointTask, measure_point, merge_point_files, remove_points, run_point,
+)
 from .references import find_cached_reference, make_reference, reference_strategies
 from .results import (
     append_csv, empty_state, legacy_max_depths, point_key, read_csv, read_state, row_key,
@@ -54,22 +60,37 @@ class Sweep:
     progress: Progress
     tmpdir: Path
     binary_hash: str
+    points_dir: Path
+    pool: Pool | None = None
+    measure: Measure = measure_point
+    threads: int | None = None  # --threads of each sweep render (None: mcrt's default)
+    share_worker_cores: bool = False  # on Dask workers without --threads
 
     def save_state(self) -> None:
         """Write the state file."""
         write_text_atomic(self.state_path, json.dumps(self.state, indent=2) + "\n")
 
 
-def run_study(settings: Settings, scenes: list[SceneInfo]) -> list[dict]:
-    """References and sweep for every scene, depth mode and configuration; returns all CSV rows."""
+def run_study(settings: Settings, scenes: list[SceneInfo], backend: Backend = Backend(),
+              measure: Measure = measure_point) -> list[dict]:
+    """References and sweep for every scene, depth mode and configuration; returns all CSV rows.
+
+    The references are rendered here, one after another; the sweep's points
+    run on the backend's executor (`measure`: how a point is rendered and
+    measured), each leaving its point file in OUT/points, merged into the CSV.
+    """
     out = settings.out
     out.mkdir(parents=True, exist_ok=True)
     csv_path = out / RESULTS_CSV
     state_path = out / STATE_JSON
+    points_dir = out / POINTS_DIR
     if settings.fresh and csv_path.exists():
         csv_path.unlink()
+    if settings.fresh:
+        shutil.rmtree(points_dir, ignore_errors=True)
     rows = read_csv(csv_path, legacy_max_depths(settings, state_path), scene_columns_lookup(settings))
     state = empty_state() if settings.fresh else read_state(state_path)
+    rows = merge_point_files(csv_path, rows, points_dir, state)
     binary_hash = sha256_file(settings.mcrt) if settings.mcrt.is_file() else ""
     done = {row_key(r) for r in rows}
 
@@ -90,15 +111,19 @@ def run_study(settings: Settings, scenes: list[SceneInfo]) -> list[dict]:
                          if point_key(scene.name, config, depth, spp, seed) not in done)
     progress = Progress(total)
     tmpdir = Path(tempfile.mkdtemp(prefix=".sweep-", dir=out))
-    sweep = Sweep(settings, rows, done, csv_path, state, state_path, progress, tmpdir, binary_hash)
+    sweep = Sweep(settings, rows, done, csv_path, state, state_path, progress, tmpdir, binary_hash,
+                  points_dir, measure=measure, threads=render_threads(settings.threads, backend, machine_cores()),
+                  share_worker_cores=backend.name == "dask")
     try:
-        for scene in scenes:
-            references: dict[int, Reference] = {}
-            for mode, depth in scene.depth_modes(settings.depths):
-                reference = prepare_depth(sweep, scene, mode, (scene.name, depth) in pending_refs)
-                if reference is not None:
-                    references[depth] = reference
-            sweep_scene(sweep, scene, references)
+        with open_pool(backend) as pool:
+            sweep.pool = pool
+            for scene in scenes:
+                references: dict[int, Reference] = {}
+                for mode, depth in scene.depth_modes(settings.depths):
+                    reference = prepare_depth(sweep, scene, mode, (scene.name, depth) in pending_refs)
+                    if reference is not None:
+                        references[depth] = reference
+                sweep_scene(sweep, scene, references)
     finally:
         progress.finish()
         shutil.rmtree(tmpdir, ignore_errors=True)
@@ -150,6 +175,7 @@ def prepare_depth(sweep: Sweep, scene: SceneInfo, mode: str, counted: bool) -> R
                               and r["seed"] in settings.seeds))
         sweep.rows = [r for r in sweep.rows if not (r["scene"] == scene.name and r["max_depth"] == depth)]
         write_csv(sweep.csv_path, sweep.rows)
+        remove_points(sweep.points_dir, scene.name, depth)
         sweep.done = {row_key(r) for r in sweep.rows}
     sweep.state["runs"][key] = {
         "run_key": run_key, "scene": scene.name, "mode": mode, "scene_file": str(scene.path),
@@ -162,52 +188,125 @@ def prepare_depth(sweep: Sweep, scene: SceneInfo, mode: str, counted: bool) -> R
     return reference
 
 
-def sweep_scene(sweep: Sweep, scene: SceneInfo, references: dict[int, Reference]) -> None:
-    """The sweep of one scene: every seed, spp, depth mode and configuration not yet in the CSV.
+@dataclass(frozen=True)
+class Point:
+    """A point of a scene's sweep: max depth, configuration, spp, seed."""
 
-    For each seed and spp, every depth mode and every configuration is
-    rendered in turn, the order of the configurations rotated by one from
-    each (seed, spp, depth) to the next, so that a change of machine load
-    affects all configurations alike and none is always first.
+    max_depth: int
+    config: Config
+    spp: int
+    seed: int
+
+
+def sweep_order(settings: Settings, depths: list[int]) -> list[Point]:
+    """Every point of a scene's sweep, in the order they are run.
+
+    For each seed and spp, every depth and every configuration in turn, the
+    order of the configurations rotated by one from each (seed, spp, depth) to
+    the next, so that a change of machine load affects all configurations alike
+    and none is always first.
     """
-    settings, progress = sweep.settings, sweep.progress
     configs = settings.configs
-    dead: dict[tuple[int, Config], McrtError] = {}
+    points: list[Point] = []
     turn = 0
     for seed in settings.seeds:
         for spp in settings.spp:
-            for depth, reference in references.items():
+            for depth in depths:
                 shift = turn % len(configs)
                 turn += 1
-                for config in configs[shift:] + configs[:shift]:
-                    key = point_key(scene.name, config, depth, spp, seed)
-                    if key in sweep.done or (depth, config) in dead:
-                        continue
-                    label = f"{scene.name} {reference.mode} {config.label} spp={spp} seed={seed}"
-                    image = sweep.tmpdir / (f"{scene.name}-{depth}-{config.strategy}-{config.integrator}-"
-                                            f"{config.sampler}-{spp}-{seed}.exr")
-                    try:
-                        seconds = render(settings, scene, config, depth, spp, seed, image)
-                        errors = diff(settings, image, reference.path)
-                    except McrtError as err:
-                        dead[(depth, config)] = err
-                        kind = "not available in this build, skipped" if err.unavailable else "FAILED"
-                        progress.message(f"{scene.name} ({reference.mode}) {config.label}: {kind}: {err}")
-                        settings.failures.append(Failure(scene.name, config.strategy, str(err), err.unavailable,
-                                                         config.integrator, config.sampler, depth))
-                        left = sum(point_work(scene, config, depth, s) for s in settings.spp for sd in settings.seeds
-                                   if point_key(scene.name, config, depth, s, sd) not in sweep.done)
-                        progress.advance(left, label)
-                        continue
-                    finally:
-                        image.unlink(missing_ok=True)
-                    row = {"scene": scene.name, "strategy": config.strategy, "integrator": config.integrator,
-                           "sampler": config.sampler, "max_depth": depth, "spp": spp, "seed": seed,
-                           "seconds": seconds, **errors, **scene_info_columns(scene)}
-                    append_csv(sweep.csv_path, row)
-                    sweep.rows.append(row)
-                    sweep.done.add(key)
-                    progress.advance(point_work(scene, config, depth, spp), label)
+                points += [Point(depth, config, spp, seed) for config in configs[shift:] + configs[:shift]]
+    return points
+
+
+def sweep_scene(sweep: Sweep, scene: SceneInfo, references: dict[int, Reference]) -> None:
+    """The sweep of one scene: every point of sweep_order not yet in the CSV, on the sweep's executor.
+
+    As many points are kept in flight as the executor has room for (one with
+    --jobs 1: each point runs when it is submitted, as before). Finished rows
+    are appended to the CSV in the sweep's order, whatever order they finish
+    in; their point files are written by the workers as they finish. When a
+    configuration fails (or is not available in this build) at a depth, its
+    points not yet submitted are skipped.
+    """
+    settings = sweep.settings
+    assert sweep.pool is not None
+    point_settings = dataclasses.replace(settings, threads=sweep.threads, failures=[])
+    run_keys = {depth: scene_run_key(scene, depth, reference) for depth, reference in references.items()}
+    columns = scene_info_columns(scene)
+    dead: dict[tuple[int, Config], str] = {}
+    inflight: dict[tuple, Point] = {}
+    finished: dict[int, dict | None] = {}  # submission number -> row (None: failed)
+    flushed = 0
+    submitted = 0
+    completions: queue.Queue = queue.Queue()
+    todo = iter(sweep_order(settings, list(references)))
+
+    def key_of(point: Point) -> tuple:
+        return point_key(scene.name, point.config, point.max_depth, point.spp, point.seed)
+
+    def next_point() -> Point | None:
+        for point in todo:
+            if key_of(point) not in sweep.done and (point.max_depth, point.config) not in dead:
+                return point
+        return None
+
+    while True:
+        room = sweep.pool.capacity() - len(inflight)
+        while room > 0 and (point := next_point()) is not None:
+            config, depth = point.config, point.max_depth
+            image = sweep.tmpdir / (f"{scene.name}-{depth}-{config.strategy}-{config.integrator}-"
+                                    f"{config.sampler}-{point.spp}-{point.seed}.exr")
+            task = PointTask(point_settings, scene, config, depth, point.spp, point.seed, image,
+                             references[depth].path, sweep.points_dir, run_keys[depth], columns,
+                             sweep.share_worker_cores)
+            inflight[key_of(point)] = point
+            number = submitted
+            submitted += 1
+            future = sweep.pool.executor.submit(run_point, task, sweep.measure)
+            future.add_done_callback(lambda f, n=number, p=point: completions.put((n, p, f)))
+            room -= 1
+        if not inflight:
+            break
+        number, point, future = completions.get()
+        finished[number] = record_outcome(sweep, scene, point, references[point.max_depth].mode, future,
+                                          dead, inflight)
+        while flushed in finished:
+            row = finished.pop(flushed)
+            flushed += 1
+            if row is not None:
+                append_csv(sweep.csv_path, row)
+                sweep.rows.append(row)
+
+
+def record_outcome(sweep: Sweep, scene: SceneInfo, point: Point, mode: str, future: Future,
+                   dead: dict[tuple[int, Config], str], inflight: dict[tuple, Point]) -> dict | None:
+    """Take in a finished point: its row (the point done), or its failure (its configuration and
+    depth dead for this scene, the rest of their work off the progress bar). Returns the row, or
+    None."""
+    settings, progress = sweep.settings, sweep.progress
+    config, depth = point.config, point.max_depth
+    key = point_key(scene.name, config, depth, point.spp, point.seed)
+    del inflight[key]
+    label = f"{scene.name} {mode} {config.label} spp={point.spp} seed={point.seed}"
+    outcome = future.result()
+    if "row" in outcome:
+        sweep.done.add(key)
+        progress.advance(point_work(scene, config, depth, point.spp), label)
+        return outcome["row"]
+    if (depth, config) in dead:  # in flight when its configuration failed
+        progress.advance(point_work(scene, config, depth, point.spp), label)
+        return None
+    err = McrtError(outcome["error"], outcome["returncode"], outcome["unavailable"])
+    dead[(depth, config)] = str(err)
+    kind = "not available in this build, skipped" if err.unavailable else "FAILED"
+    progress.message(f"{scene.name} ({mode}) {config.label}: {kind}: {err}")
+    settings.failures.append(Failure(scene.name, config.strategy, str(err), err.unavailable,
+                                     config.integrator, config.sampler, depth))
+    left = sum(point_work(scene, config, depth, s) for s in settings.spp for sd in settings.seeds
+               if point_key(scene.name, config, depth, s, sd) not in sweep.done
+               and point_key(scene.name, config, depth, s, sd) not in inflight)
+    progress.advance(left, label)
+    return None
 
 
 def run_sampler_bench(settings: Settings) -> list[dict] | None:
