@@ -41,6 +41,7 @@
 #include "mcrt/samplers/sobol_sampler.hpp"
 #include "mcrt/samplers/stratified.hpp"
 #include "mcrt/sampling/auto_strategy.hpp"
+#include "mcrt/sampling/auto_table.hpp"
 #include "mcrt/sampling/bilinear_spherical_ellipse.hpp"
 #include "mcrt/sampling/bilinear_spherical_rectangle.hpp"
 #include "mcrt/sampling/ellipse_area.hpp"

@@ -30,17 +30,28 @@
 // costs from the README's cost tables, c_rest from the error-against-time
 // study (cornell_rect, nee, sobol: ms per spp of area and solid-angle
 // sampling, 318 and 451 ns per path at 1.13 light samples per path, leave
-// 265 ns per light sample for the rest), v_rest = 0.25 the value, of those
-// tried (0.25, 1, 4), with the best worst case over the study's scenes
+// 265 ns per light sample for the rest), v_rest = 1 the value, of those
+// tried (0.25, 1, 4, 16), with the best worst case over the study's scenes
 // (README, "Choosing per shading point", which also says how far this rule
 // is from the best fixed strategy).
+//
+// Where a receiver is close to a planar light (within a fraction of its
+// size) g peaks near the light's nearest point and no fixed quadrature
+// sees the peak; the model then takes the peak's own variance (see
+// auto_choice::v_area). auto_sampler evaluates the rule of a planar light
+// once per cell of a table of receiver positions and normals
+// (auto_table.hpp), so a shading point pays a lookup, not the rule.
 #include <algorithm>
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 #include "mcrt/core/onb.hpp"
 #include "mcrt/geometry/ellipse.hpp"
 #include "mcrt/geometry/rect.hpp"
 #include "mcrt/geometry/sphere.hpp"
 #include "mcrt/sampling/ellipse_area.hpp"
+#include "mcrt/sampling/auto_table.hpp"
 #include "mcrt/sampling/light_sample.hpp"
 #include "mcrt/sampling/projected_rectangle.hpp"
 #include "mcrt/sampling/projected_spherical_cap.hpp"
@@ -58,7 +69,7 @@ namespace mcrt {
 // render --auto-rest-cost --auto-rest-variance` sets them).
 struct auto_params {
   float rest_cost = 265.0f;      // c_rest, ns per light sample
-  float rest_variance = 0.25f;   // v_rest
+  float rest_variance = 1.0f;    // v_rest
 };
 
 // Time per light sample (ns, sample + pdf) of each strategy of a shape.
@@ -93,11 +104,27 @@ class auto_choice {
     sg_ += weight * g, sg2_ += weight * g * g, sw_ += weight * w, swc_ += weight * w * c, swc2_ += weight * w * c * c;
   }
 
+  // The weighted sums of a planar light's points, formed by planar_rule
+  // (with cos(theta_l) = h / r, h the receiver's height over the plane,
+  // which cancels from both ratios and is left out of every sum).
+  void set_sums(float sg, float sg2, float sw, float swc, float swc2, float g_peak) {
+    sg_ = sg, sg2_ = sg2, sw_ = sw, swc_ = swc, swc2_ = swc2, g_peak_ = g_peak;
+  }
+
   // Relative variances of the area and solid-angle estimates (header).
+  // v_area: the quadrature's, unless g at the light's nearest point exceeds
+  // twice the quadrature's mean: then the receiver is close to the light
+  // (within a fraction of its size), g ~ delta^2 / r^4 peaks at the nearest
+  // point, and a fixed rule misses the peak; there the variance of that
+  // peak, (q - 1) / 3 with q = g_peak / E[g] (for g = delta^2 / r^4 over a
+  // large light E_A[g^2] / E_A[g]^2 = A / (3 pi delta^2) = q / 3), bounds it
+  // from below. At q = 2 both forms give 1/3 (g linear from 0 to 2 E[g]).
   float v_area() const {
     if (!(sg_ > 0.0f)) return 0.0f;
-    return std::max(sg2_ / (sg_ * sg_) - 1.0f, 0.0f);
+    const float v = std::max(sg2_ / (sg_ * sg_) - 1.0f, 0.0f);
+    return peaked() ? std::max(v, (g_peak_ / sg_ - 1.0f) * (1.0f / 3.0f)) : v;
   }
+  bool peaked() const { return g_peak_ > 2.0f * sg_; }
   float v_solid_angle() const {
     if (!(swc_ > 0.0f)) return 0.0f;
     return std::max(sw_ * swc2_ / (swc_ * swc_) - 1.0f, 0.0f);
@@ -105,8 +132,11 @@ class auto_choice {
 
   // Whether area sampling is the choice even with v_area and v_sa taken
   // `factor` times larger than modelled (and lit at all).
+  // Never where g peaks (near the light, see v_area): a coarse rule's
+  // mean is too rough there for the peak's size.
   bool area_wins_even_if(float factor, const auto_costs::shape_costs& c, const auto_params& p) const {
     if (!(sg_ > 0.0f)) return true;
+    if (peaked()) return false;
     const float area = (c.area + p.rest_cost) * (factor * v_area() + p.rest_variance);
     return area <= (c.solid_angle + p.rest_cost) * p.rest_variance &&
            area <= (c.projected_solid_angle + p.rest_cost) * p.rest_variance;
@@ -126,63 +156,211 @@ class auto_choice {
 
  private:
   vec3 o_, n_;
-  float sg_ = 0.0f, sg2_ = 0.0f, sw_ = 0.0f, swc_ = 0.0f, swc2_ = 0.0f;
+  float sg_ = 0.0f, sg2_ = 0.0f, sw_ = 0.0f, swc_ = 0.0f, swc2_ = 0.0f, g_peak_ = 0.0f;
 };
 
-// The model at o (normal n) for each shape, from its four quadrature
-// points, and the choice.
-// The coarse rules: 2x2 Gauss points on a rectangle, one ring of four
-// points at rho = 1/sqrt(2) on an ellipse (both exact for quadratics).
-inline auto_choice auto_model_coarse(const rect& r, const vec3& o, const vec3& n) {
-  constexpr float lo = 0.5f - 0.28867513f, hi = 0.5f + 0.28867513f;  // 1/2 -+ 1/(2 sqrt 3)
-  auto_choice ch(o, n);
-  for (const float s : {lo, hi})
-    for (const float t : {lo, hi}) {
-      const vec3 p = r.corner + s * r.e1 + t * r.e2;
-      ch.add(p, glm::dot(o - p, r.n) / glm::length(o - p), 0.25f);
-    }
-  return ch;
-}
-inline auto_choice auto_model_coarse(const ellipse& e, const vec3& o, const vec3& n) {
-  constexpr float k = 0.70710678f;
-  auto_choice ch(o, n);
-  for (const vec3& a : {k * e.a1, -k * e.a1, k * e.a2, -k * e.a2}) {
-    const vec3 p = e.center + a;
-    ch.add(p, glm::dot(o - p, e.n) / glm::length(o - p), 0.25f);
-  }
-  return ch;
-}
+// The rule of a planar light (rectangle or ellipse), with what depends on
+// the light alone computed once: its centre and half-axes for the delta
+// method, the quadrature points of the coarse and the fine rule (SoA, so
+// the per-point work is a few packed operations), and how to clamp a
+// point of the plane onto the light (for the peak of g).
+//
+// Per point of the light, with d = p - o, r^2 = d . d and h the receiver's
+// height over the plane (cos(theta_l) = h / r): g = cos+(theta) cos(theta_l)
+// / r^2 = h (d . n)+ / r^4, the solid angle per unit area w = h / r^3; h
+// cancels from v_area and v_sa and is dropped.
+class planar_rule {
+ public:
+  static constexpr int coarse_points = 4, fine_points = 12;
 
-inline auto_choice auto_model(const rect& r, const vec3& o, const vec3& n) {
-  // 3x3 Gauss-Legendre points on the rectangle (exact for degree 5 in each
-  // coordinate): 1/2 -+ sqrt(3/5)/2 and 1/2, weights 5/18, 8/18, 5/18.
-  constexpr float x[3] = {0.5f - 0.38729833f, 0.5f, 0.5f + 0.38729833f};
-  constexpr float w[3] = {5.0f / 18.0f, 8.0f / 18.0f, 5.0f / 18.0f};
-  auto_choice ch(o, n);
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      const vec3 p = r.corner + x[i] * r.e1 + x[j] * r.e2;
-      ch.add(p, glm::dot(o - p, r.n) / glm::length(o - p), w[i] * w[j]);
+  explicit planar_rule(const rect& r, const auto_costs::shape_costs& c = auto_costs::rect)
+      : costs_(c), center_(r.corner + 0.5f * (r.e1 + r.e2)), E1_(r.e1), E2_(r.e2), nl_(r.n), k_(1.0f / 12.0f),
+        rect_(true), corner_(r.corner), dual1_(r.e1_dual), dual2_(r.e2_dual) {
+    // Coarse: 2x2 Gauss points, 1/2 -+ 1/(2 sqrt 3). Fine: 3x3 Gauss-Legendre
+    // points (exact for degree 5 in each coordinate), 1/2 -+ sqrt(3/5)/2 and
+    // 1/2, weights 5/18, 8/18, 5/18; three padding points of weight 0.
+    constexpr float lo = 0.5f - 0.28867513f, hi = 0.5f + 0.28867513f;
+    int k = 0;
+    for (const float s : {lo, hi})
+      for (const float t : {lo, hi}) set(coarse_, k++, r.corner + s * r.e1 + t * r.e2, 0.25f);
+    constexpr float x[3] = {0.5f - 0.38729833f, 0.5f, 0.5f + 0.38729833f};
+    constexpr float w[3] = {5.0f / 18.0f, 8.0f / 18.0f, 5.0f / 18.0f};
+    k = 0;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) set(fine_, k++, r.corner + x[i] * r.e1 + x[j] * r.e2, w[i] * w[j]);
+    for (; k < fine_points; ++k) set(fine_, k, center_, 0.0f);
+  }
+  explicit planar_rule(const ellipse& e, const auto_costs::shape_costs& c = auto_costs::ellipse)
+      : costs_(c), center_(e.center), E1_(e.a1), E2_(e.a2), nl_(e.n), k_(0.25f), rect_(false),
+        corner_(e.center), dual1_(e.a1_dual), dual2_(e.a2_dual) {
+    // Coarse: one ring of four points at rho = 1/sqrt(2). Fine: three rings
+    // by area (rho^2 = 1/2 -+ sqrt(3/5)/2 and 1/2, the 3-point Gauss rule in
+    // rho^2, weights 5/18, 8/18, 5/18) of four points each, the middle ring
+    // turned by 45 degrees. Both exact for quadratics.
+    constexpr float kd = 0.70710678f;
+    int k = 0;
+    for (const vec3& a : {kd * e.a1, -kd * e.a1, kd * e.a2, -kd * e.a2}) set(coarse_, k++, e.center + a, 0.25f);
+    constexpr float rho[3] = {0.33571069f, 0.70710678f, 0.94196515f};
+    constexpr float w[3] = {5.0f / 72.0f, 8.0f / 72.0f, 5.0f / 72.0f};  // per point (four per ring)
+    const vec3 axis_dirs[4] = {e.a1, e.a2, -e.a1, -e.a2};
+    const vec3 diagonal_dirs[4] = {kd * (e.a1 + e.a2), kd * (e.a2 - e.a1), -kd * (e.a1 + e.a2), kd * (e.a1 - e.a2)};
+    k = 0;
+    for (int ring = 0; ring < 3; ++ring)
+      for (int i = 0; i < 4; ++i) set(fine_, k++, e.center + rho[ring] * (ring == 1 ? diagonal_dirs[i] : axis_dirs[i]), w[ring]);
+  }
+
+  // First-order (delta-method) v_area at the light's centre (offsets s E1 +
+  // t E2 over the light, variances k each: 1/12 for a rectangle's edges,
+  // 1/4 for an ellipse's semi-axes): log g = log(n . d) - 4 log r + const,
+  // d = p - o, so v_area ~ k ((grad log g . E1)^2 + (grad log g . E2)^2)
+  // with grad log g = n / (n . d) - 4 d / r^2. Valid (true, with v_area)
+  // only where each part of the gradient changes log g by at most 0.3
+  // across the light, so that the first-order term is all that matters
+  // (within a factor 2 on the test receivers: tests/test_auto_strategy.cpp).
+  // One division: the gradient's parts over the common denominator
+  // (n . d) r^2.
+  bool delta_v_area(const vec3& o, const vec3& n, float& v_area) const {
+    if (!(glm::dot(o - center_, nl_) > 0.0f)) return false;  // behind the light
+    const vec3 d = center_ - o;
+    const float r2 = glm::dot(d, d), nd = glm::dot(n, d);
+    if (!(nd > 0.0f) || !(r2 > 0.0f)) return false;
+    const float n1 = glm::dot(n, E1_), n2 = glm::dot(n, E2_);
+    const float d1 = 4.0f * glm::dot(d, E1_), d2 = 4.0f * glm::dot(d, E2_);
+    if (!(0.5f * (std::abs(n1) + std::abs(n2)) <= 0.3f * nd) || !(0.5f * (std::abs(d1) + std::abs(d2)) <= 0.3f * r2))
+      return false;
+    const float inv = 1.0f / (nd * r2);
+    const float g1 = (n1 * r2 - d1 * nd) * inv, g2 = (n2 * r2 - d2 * nd) * inv;
+    v_area = k_ * (g1 * g1 + g2 * g2);
+    return true;
+  }
+
+  auto_choice coarse(const vec3& o, const vec3& n) const { return model(coarse_, o, n); }
+  auto_choice fine(const vec3& o, const vec3& n) const { return model(fine_, o, n); }
+
+  // The choice: the delta method, where valid, then the coarse rule
+  // (within a factor 4 of the variances on the test receivers); where even
+  // twice, resp. four times, their v_area leaves area sampling the best,
+  // that is the choice; otherwise the fine rule decides.
+  light_sampling choose(const vec3& o, const vec3& n, const auto_params& p) const {
+    const auto_costs::shape_costs& c = costs_;
+    float v_delta;
+    if (delta_v_area(o, n, v_delta)) {
+      const float area = (c.area + p.rest_cost) * (2.0f * v_delta + p.rest_variance);
+      if (area <= (c.solid_angle + p.rest_cost) * p.rest_variance &&
+          area <= (c.projected_solid_angle + p.rest_cost) * p.rest_variance)
+        return light_sampling::area;
     }
-  return ch;
-}
-inline auto_choice auto_model(const ellipse& e, const vec3& o, const vec3& n) {
-  // Three rings by area (rho^2 = 1/2 -+ sqrt(3/5)/2 and 1/2, the 3-point
-  // Gauss rule in rho^2, weights 5/18, 8/18, 5/18) of four points each, the
-  // middle ring turned by 45 degrees.
-  constexpr float rho[3] = {0.33571069f, 0.70710678f, 0.94196515f};
-  constexpr float w[3] = {5.0f / 72.0f, 8.0f / 72.0f, 5.0f / 72.0f};  // per point (four per ring)
-  constexpr float k = 0.70710678f;
-  const vec3 axis_dirs[4] = {e.a1, e.a2, -e.a1, -e.a2};
-  const vec3 diagonal_dirs[4] = {k * (e.a1 + e.a2), k * (e.a2 - e.a1), -k * (e.a1 + e.a2), k * (e.a1 - e.a2)};
-  auto_choice ch(o, n);
-  for (int ring = 0; ring < 3; ++ring)
+    if (coarse(o, n).area_wins_even_if(4.0f, c, p)) return light_sampling::area;
+    return fine(o, n).choose(c, p);
+  }
+
+ private:
+  template <int N>
+  struct points {
+    std::array<float, N> x{}, y{}, z{}, w{};
+  };
+  template <int N>
+  static void set(points<N>& pts, int k, const vec3& p, float w) {
+    pts.x[k] = p.x, pts.y[k] = p.y, pts.z[k] = p.z, pts.w[k] = w;
+  }
+
+  // The point of the plane x clamped onto the light: to the rectangle, or
+  // pulled radially into the ellipse (nearest to within its eccentricity:
+  // only the peak's size matters).
+  vec3 clamp_to_light(const vec3& x) const {
+    const vec3 q = x - corner_;
+    float s = glm::dot(q, dual1_), t = glm::dot(q, dual2_);
+    if (rect_) return corner_ + std::clamp(s, 0.0f, 1.0f) * E1_ + std::clamp(t, 0.0f, 1.0f) * E2_;
+    const float rho2 = s * s + t * t;
+    if (rho2 > 1.0f) {
+      const float k = 1.0f / std::sqrt(rho2);
+      s *= k, t *= k;
+    }
+    return corner_ + s * E1_ + t * E2_;
+  }
+
+  // Sums over four points of the light at once (x, y, z, weight; the
+  // weights of the peak's candidates are 0): the terms of
+  // auto_choice::set_sums, and the largest g / h. Packed (SSE) where
+  // available: one division and one square root for the four.
+  struct sums {
+    float sg = 0.0f, sg2 = 0.0f, sw = 0.0f, swc2 = 0.0f, g_max = 0.0f;
+  };
+  static void accumulate4(const float* x, const float* y, const float* z, const float* wt, const vec3& o,
+                          const vec3& n, sums& s) {
+#if defined(__SSE2__)
+    const __m128 dx = _mm_sub_ps(_mm_loadu_ps(x), _mm_set1_ps(o.x)), dy = _mm_sub_ps(_mm_loadu_ps(y), _mm_set1_ps(o.y)),
+                 dz = _mm_sub_ps(_mm_loadu_ps(z), _mm_set1_ps(o.z));
+    const __m128 r2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    const __m128 dn = _mm_max_ps(
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, _mm_set1_ps(n.x)), _mm_mul_ps(dy, _mm_set1_ps(n.y))),
+                   _mm_mul_ps(dz, _mm_set1_ps(n.z))),
+        _mm_setzero_ps());
+    const __m128 inv_r2 = _mm_div_ps(_mm_set1_ps(1.0f), r2), inv_r = _mm_sqrt_ps(inv_r2);
+    const __m128 g = _mm_mul_ps(dn, _mm_mul_ps(inv_r2, inv_r2));  // g / h
+    const __m128 w = _mm_mul_ps(inv_r2, inv_r);                    // solid angle per unit area / h
+    const __m128 W = _mm_loadu_ps(wt), Wg = _mm_mul_ps(W, g);
+    alignas(16) float t[4][4];
+    _mm_store_ps(t[0], Wg);
+    _mm_store_ps(t[1], _mm_mul_ps(Wg, g));
+    _mm_store_ps(t[2], _mm_mul_ps(W, w));
+    _mm_store_ps(t[3], _mm_mul_ps(Wg, _mm_mul_ps(dn, inv_r)));  // W g cos+(theta)
+    alignas(16) float gm[4];
+    _mm_store_ps(gm, g);
+    s.sg += (t[0][0] + t[0][1]) + (t[0][2] + t[0][3]);
+    s.sg2 += (t[1][0] + t[1][1]) + (t[1][2] + t[1][3]);
+    s.sw += (t[2][0] + t[2][1]) + (t[2][2] + t[2][3]);
+    s.swc2 += (t[3][0] + t[3][1]) + (t[3][2] + t[3][3]);
+    s.g_max = std::max({s.g_max, gm[0], gm[1], gm[2], gm[3]});
+#else
     for (int i = 0; i < 4; ++i) {
-      const vec3 p = e.center + rho[ring] * (ring == 1 ? diagonal_dirs[i] : axis_dirs[i]);
-      ch.add(p, glm::dot(o - p, e.n) / glm::length(o - p), w[ring]);
+      const float dx = x[i] - o.x, dy = y[i] - o.y, dz = z[i] - o.z;
+      const float r2 = dx * dx + dy * dy + dz * dz;
+      const float dn = std::max(dx * n.x + dy * n.y + dz * n.z, 0.0f);
+      const float inv_r2 = 1.0f / r2, inv_r = std::sqrt(inv_r2);
+      const float g = dn * inv_r2 * inv_r2, w = inv_r2 * inv_r;
+      s.sg += wt[i] * g, s.sg2 += wt[i] * g * g, s.sw += wt[i] * w, s.swc2 += wt[i] * g * dn * inv_r;
+      s.g_max = std::max(s.g_max, g);
     }
-  return ch;
-}
+#endif
+  }
+
+  // The model over the points pts, with the peak of g / h (auto_choice::
+  // v_area): for a receiver at height h over the plane, g peaks at o's
+  // foot on the plane when n faces the light, and h / sqrt(3) along n's
+  // part in the plane from there when n lies in it (x / (x^2 + h^2)^2
+  // peaks there); both candidates, each clamped onto the light, enter as
+  // points of weight 0 whose largest g is the peak.
+  template <int N>
+  auto_choice model(const points<N>& pts, const vec3& o, const vec3& n) const {
+    static_assert(N % 4 == 0);
+    auto_choice ch(o, n);
+    const float h = glm::dot(o - center_, nl_);
+    if (!(h > 0.0f)) return ch;  // behind the light: nothing lit
+    sums s;
+    for (int i = 0; i < N; i += 4) accumulate4(&pts.x[i], &pts.y[i], &pts.z[i], &pts.w[i], o, n, s);
+    const float g_quad_max = s.g_max;
+    const vec3 foot = o - h * nl_;
+    const float nn = glm::dot(n, nl_), t2 = 1.0f - nn * nn;  // |n's part in the plane|^2
+    const vec3 a = clamp_to_light(foot);
+    const vec3 b = t2 > 0.0f ? clamp_to_light(foot + (0.57735027f * h / std::sqrt(t2)) * (n - nn * nl_)) : a;
+    const float px[4] = {a.x, b.x, a.x, b.x}, py[4] = {a.y, b.y, a.y, b.y}, pz[4] = {a.z, b.z, a.z, b.z};
+    constexpr float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    s.g_max = 0.0f;
+    accumulate4(px, py, pz, zero, o, n, s);
+    ch.set_sums(s.sg, s.sg2, s.sw, s.sg, s.swc2, std::max(s.g_max, g_quad_max));
+    return ch;
+  }
+
+  auto_costs::shape_costs costs_;
+  vec3 center_, E1_, E2_, nl_;
+  float k_;
+  bool rect_;
+  vec3 corner_, dual1_, dual2_;  // rect: corner and e_i / |e_i|^2; ellipse: centre and a_i / |a_i|^2
+  points<coarse_points> coarse_;
+  points<fine_points> fine_;
+};
+
 // The visible cap (the part of the surface facing o: cos beta >= r / d at
 // the centre, beta from the direction to o), uniform by area in cos beta:
 // two rings at the 2-point Gauss nodes in cos beta of four points each, the
@@ -207,61 +385,25 @@ inline auto_choice auto_model(const sphere& s, const vec3& o, const vec3& n) {
   return ch;
 }
 
-// First-order (delta-method) variances at the centre of a planar light
-// with centre c and axes E1, E2 (offsets s E1 + t E2 over the light with
-// variances k each: 1/12 for a rectangle's edges, 1/4 for an ellipse's
-// semi-axes): log g = log(n . d) - 4 log r + const, d = p - o, so
-// v_area ~ k ((grad log g . E1)^2 + (grad log g . E2)^2) with grad log g =
-// n / (n . d) - 4 d / r^2. Valid (true, with v_area) only where each part
-// of the gradient changes log g by at most 0.3 across the light, so that
-// the first-order term is all that matters (within a factor 2 on the test
-// receivers: tests/test_auto_strategy.cpp).
-inline bool delta_v_area(const vec3& c, const vec3& E1, const vec3& E2, float k, const vec3& o, const vec3& n,
-                         float& v_area) {
-  const vec3 d = c - o;
-  const float r2 = glm::dot(d, d), nd = glm::dot(n, d);
-  if (!(nd > 0.0f) || !(r2 > 0.0f)) return false;
-  const float inv_nd = 1.0f / nd, inv_r2 = 1.0f / r2;
-  const float n1 = glm::dot(n, E1) * inv_nd, n2 = glm::dot(n, E2) * inv_nd;
-  const float d1 = 4.0f * glm::dot(d, E1) * inv_r2, d2 = 4.0f * glm::dot(d, E2) * inv_r2;
-  if (!(0.5f * (std::abs(n1) + std::abs(n2)) <= 0.3f) || !(0.5f * (std::abs(d1) + std::abs(d2)) <= 0.3f)) return false;
-  const float g1 = n1 - d1, g2 = n2 - d2;
-  v_area = k * (g1 * g1 + g2 * g2);
-  return true;
+// The planar rules as functions of (light, o, n) (each builds the light's
+// rule; auto_sampler keeps it instead).
+inline auto_choice auto_model_coarse(const rect& r, const vec3& o, const vec3& n) { return planar_rule(r).coarse(o, n); }
+inline auto_choice auto_model_coarse(const ellipse& e, const vec3& o, const vec3& n) {
+  return planar_rule(e).coarse(o, n);
 }
+inline auto_choice auto_model(const rect& r, const vec3& o, const vec3& n) { return planar_rule(r).fine(o, n); }
+inline auto_choice auto_model(const ellipse& e, const vec3& o, const vec3& n) { return planar_rule(e).fine(o, n); }
 inline bool delta_v_area(const rect& r, const vec3& o, const vec3& n, float& v) {
-  if (!(glm::dot(o - r.corner, r.n) > 0.0f)) return false;  // behind the light
-  return delta_v_area(r.corner + 0.5f * (r.e1 + r.e2), r.e1, r.e2, 1.0f / 12.0f, o, n, v);
+  return planar_rule(r).delta_v_area(o, n, v);
 }
 inline bool delta_v_area(const ellipse& e, const vec3& o, const vec3& n, float& v) {
-  if (!(glm::dot(o - e.center, e.n) > 0.0f)) return false;
-  return delta_v_area(e.center, e.a1, e.a2, 0.25f, o, n, v);
-}
-
-// The choice. Planar lights try two cheap estimates first: the delta
-// method, where valid, then the 2x2 Gauss rule (within a factor 4 of the
-// variances on the test receivers); where even twice, resp. four times,
-// their v_area leaves area sampling the best, that is the choice;
-// otherwise the finer rule decides.
-template <class Planar>
-light_sampling choose_planar(const Planar& l, const vec3& o, const vec3& n, const auto_costs::shape_costs& c,
-                             const auto_params& p) {
-  float v_delta;
-  if (delta_v_area(l, o, n, v_delta)) {
-    const float area = (c.area + p.rest_cost) * (2.0f * v_delta + p.rest_variance);
-    if (area <= (c.solid_angle + p.rest_cost) * p.rest_variance &&
-        area <= (c.projected_solid_angle + p.rest_cost) * p.rest_variance)
-      return light_sampling::area;
-  }
-  const auto_choice coarse = auto_model_coarse(l, o, n);
-  if (coarse.area_wins_even_if(4.0f, c, p)) return light_sampling::area;
-  return auto_model(l, o, n).choose(c, p);
+  return planar_rule(e).delta_v_area(o, n, v);
 }
 inline light_sampling choose_strategy(const rect& r, const vec3& o, const vec3& n, const auto_params& p = {}) {
-  return choose_planar(r, o, n, auto_costs::rect, p);
+  return planar_rule(r).choose(o, n, p);
 }
 inline light_sampling choose_strategy(const ellipse& e, const vec3& o, const vec3& n, const auto_params& p = {}) {
-  return choose_planar(e, o, n, auto_costs::ellipse, p);
+  return planar_rule(e).choose(o, n, p);
 }
 // Spheres: a cap above the horizon whose cosine varies little is the
 // cone's without the quadrature. To first order in the cap's size v_sa =
@@ -284,8 +426,52 @@ inline light_sampling choose_strategy(const sphere& s, const vec3& o, const vec3
   return auto_model(s, o, n).choose(c, p);
 }
 
+// The per-light rule auto_sampler uses. Planar lights: the rule above,
+// tabulated over cells of the receiver's position and normal (auto_table.hpp:
+// a lookup per shading point instead of the rule's tens of ns).
+class tabulated_planar_rule {
+ public:
+  tabulated_planar_rule(const rect& r, const auto_params& p)
+      : tabulated_planar_rule(planar_rule(r), r.corner + 0.5f * (r.e1 + r.e2), 0.5f * r.e1, 0.5f * r.e2, r.n, p) {}
+  tabulated_planar_rule(const ellipse& e, const auto_params& p)
+      : tabulated_planar_rule(planar_rule(e), e.center, e.a1, e.a2, e.n, p) {}
+
+  // Area behind the light (nothing is sampled there).
+  light_sampling choose(const vec3& o, const vec3& n) const {
+    if (!(glm::dot(o - centre_, nl_) > 0.0f)) return light_sampling::area;
+    return table_.lookup(o, n);
+  }
+
+ private:
+  tabulated_planar_rule(const planar_rule& rule, const vec3& c, const vec3& h1, const vec3& h2, const vec3& nl,
+                        const auto_params& p)
+      : centre_(c), nl_(nl), table_(c, h1, h2, nl, [&](const vec3& o, const vec3& n) { return rule.choose(o, n, p); }) {}
+  vec3 centre_, nl_;
+  planar_auto_table table_;
+};
+// Spheres: the rule itself (its early test for caps above the horizon is
+// cheap).
+class sphere_rule {
+ public:
+  sphere_rule(const sphere& s, const auto_params& p) : s_(s), p_(p) {}
+  light_sampling choose(const vec3& o, const vec3& n) const { return choose_strategy(s_, o, n, p_); }
+
+ private:
+  sphere s_;
+  auto_params p_;
+};
+template <class Shape>
+struct auto_rule_of {
+  using type = tabulated_planar_rule;
+};
+template <>
+struct auto_rule_of<sphere> {
+  using type = sphere_rule;
+};
+
 // The strategy itself: the three samplers of one shape and the per-point
-// choice. pdf per unit SOLID ANGLE: the chosen strategy's.
+// choice (its rule built once per light). pdf per unit SOLID ANGLE: the
+// chosen strategy's.
 template <class Shape, class Area, class SolidAngle, class Projected>
 struct auto_sampler {
   Shape shape;
@@ -295,11 +481,11 @@ struct auto_sampler {
   auto_params params;
 
   explicit auto_sampler(const Shape& s, const auto_params& p = {})
-      : shape(s), area{s}, solid_angle{s}, projected{s}, params(p) {}
+      : shape(s), area{s}, solid_angle{s}, projected{s}, params(p), rule_(s, p) {}
 
   bool faces(const vec3& o) const { return area.faces(o); }
 
-  light_sampling choice(const vec3& o, const vec3& n) const { return choose_strategy(shape, o, n, params); }
+  light_sampling choice(const vec3& o, const vec3& n) const { return rule_.choose(o, n); }
 
   bool sample(const vec3& o, const vec3& n, vec2 u, light_sample& s) const {
     switch (choice(o, n)) {
@@ -308,13 +494,21 @@ struct auto_sampler {
       default: return projected.sample(o, n, u, s);
     }
   }
+  // A direction whose area density is 0 misses the light (or o is behind
+  // it): every strategy's density is 0 there, and no choice is made (most
+  // directions a BSDF samples miss a light).
   float pdf(const vec3& o, const vec3& n, const vec3& dir) const {
+    const float pa = area.pdf(o, dir);
+    if (!(pa > 0.0f)) return 0.0f;
     switch (choice(o, n)) {
-      case light_sampling::area: return area.pdf(o, dir);
+      case light_sampling::area: return pa;
       case light_sampling::solid_angle: return solid_angle.pdf(o, dir);
       default: return projected.pdf(o, n, dir);
     }
   }
+
+ private:
+  typename auto_rule_of<Shape>::type rule_;
 };
 
 using rect_auto_sampler =

@@ -1,0 +1,125 @@
+#pragma once
+// The `auto` choice of a planar light, tabulated. The rule of
+// auto_strategy.hpp costs tens of ns per shading point (a delta-method test,
+// then quadratures of 4 and 12 points), as much as a third of a direct-light
+// path in a simple scene. The table makes the choice a lookup: the space
+// around the light is cut into cells of the receiver's position (in the
+// light's frame: two lateral coordinates and the height over its plane) and
+// of its normal (octahedral map in the light's frame), and each cell holds
+// the rule's choice at the cell's centre, computed once, when the light is
+// made. The choice is thus a function of (light, o, n) alone, piecewise
+// constant, so sample(), pdf() and the true density agree as for every
+// strategy; only where a cell straddles the rule's boundary does a point
+// get its neighbour's choice.
+//
+// Coordinates: the light and the rule are symmetric under x -> -x (with n's
+// x component) and y -> -y along its two axes, so the table holds the
+// quadrant x, y >= 0 and a receiver elsewhere is reflected into it first.
+// Lateral |x| / (|x| + s_i) in [0, 1) with s_i the light's half
+// extent along axis i (a rectangle's half edge, an ellipse's semi-axis), and
+// height h / (h + s_h) in [0, 1) with s_h = sqrt(s_1 s_2), so that cells are
+// fine near the light, where the choice changes, and cover every distance
+// (far receivers share the outermost cells, where the rule's choice no
+// longer changes with distance: the variances fall as (size / distance)^2).
+// Normals: the octahedral map (Meyer et al. 2010, "On floating-point normal
+// vectors", EGSR) of n in the light's frame onto [-1, 1]^2.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "mcrt/core/math.hpp"
+#include "mcrt/sampling/light_sample.hpp"
+
+namespace mcrt {
+
+class planar_auto_table {
+ public:
+  // Cells per coordinate: lateral (over the quadrant), height, and each of
+  // the normal's two.
+  static constexpr int lateral_cells = 16, height_cells = 16, normal_cells = 16;
+  static constexpr std::size_t cell_count =
+      std::size_t(lateral_cells) * lateral_cells * height_cells * normal_cells * normal_cells;
+
+  planar_auto_table() = default;
+
+  // centre, the two half-extent vectors (orthogonal) and the unit normal of
+  // the light's front; choose(o, n) the rule to tabulate.
+  template <class Rule>
+  planar_auto_table(const vec3& centre, const vec3& half1, const vec3& half2, const vec3& normal, const Rule& choose)
+      : c_(centre), nl_(normal) {
+    s1_ = glm::length(half1);
+    s2_ = glm::length(half2);
+    u1_ = half1 / s1_;
+    u2_ = half2 / s2_;
+    sh_ = std::sqrt(s1_ * s2_);
+    auto cells = std::make_shared<std::vector<std::uint8_t>>(cell_count);
+    for (int ix = 0; ix < lateral_cells; ++ix)
+      for (int iy = 0; iy < lateral_cells; ++iy)
+        for (int ih = 0; ih < height_cells; ++ih) {
+          const float x = expand(centre_of(ix, lateral_cells, 0.0f, 1.0f), s1_);
+          const float y = expand(centre_of(iy, lateral_cells, 0.0f, 1.0f), s2_);
+          const float h = expand(centre_of(ih, height_cells, 0.0f, 1.0f), sh_);
+          const vec3 o = c_ + x * u1_ + y * u2_ + h * nl_;
+          for (int a = 0; a < normal_cells; ++a)
+            for (int b = 0; b < normal_cells; ++b) {
+              const vec3 nloc = octahedral_decode(centre_of(a, normal_cells, -1.0f, 1.0f),
+                                                  centre_of(b, normal_cells, -1.0f, 1.0f));
+              const vec3 n = glm::normalize(nloc.x * u1_ + nloc.y * u2_ + nloc.z * nl_);
+              (*cells)[index(ix, iy, ih, a, b)] = static_cast<std::uint8_t>(choose(o, n));
+            }
+        }
+    cells_ = std::move(cells);
+  }
+
+  bool empty() const { return !cells_; }
+
+  // The tabulated choice at o (in front of the light: h > 0) for the unit
+  // normal n.
+  light_sampling lookup(const vec3& o, const vec3& n) const {
+    const vec3 d = o - c_;
+    const float x0 = glm::dot(d, u1_), y0 = glm::dot(d, u2_), h = glm::dot(d, nl_);
+    // Reflected into the quadrant x, y >= 0, n with it.
+    const float x = std::abs(x0), y = std::abs(y0);
+    const float nx = std::copysign(1.0f, x0) * glm::dot(n, u1_), ny = std::copysign(1.0f, y0) * glm::dot(n, u2_);
+    const float nz = glm::dot(n, nl_);
+    const float inv_l1 = 1.0f / (std::abs(nx) + std::abs(ny) + std::abs(nz));
+    float a = nx * inv_l1, b = ny * inv_l1;
+    if (nz < 0.0f) {
+      const float a0 = a;
+      a = std::copysign(1.0f - std::abs(b), a0);
+      b = std::copysign(1.0f - std::abs(a0), b);
+    }
+    const int ix = cell(x / (x + s1_), lateral_cells, 0.0f, 1.0f);
+    const int iy = cell(y / (y + s2_), lateral_cells, 0.0f, 1.0f);
+    const int ih = cell(std::max(h, 0.0f) / (std::max(h, 0.0f) + sh_), height_cells, 0.0f, 1.0f);
+    const int ia = cell(a, normal_cells, -1.0f, 1.0f), ib = cell(b, normal_cells, -1.0f, 1.0f);
+    return static_cast<light_sampling>((*cells_)[index(ix, iy, ih, ia, ib)]);
+  }
+
+ private:
+  static std::size_t index(int ix, int iy, int ih, int a, int b) {
+    return (((std::size_t(ix) * lateral_cells + iy) * height_cells + ih) * normal_cells + a) * normal_cells + b;
+  }
+  // The cell of t in [lo, hi) cut into k (NaN and the ends clamped).
+  static int cell(float t, int k, float lo, float hi) {
+    const float f = (t - lo) / (hi - lo) * float(k);
+    return f >= 0.0f ? std::min(int(f), k - 1) : 0;
+  }
+  static float centre_of(int i, int k, float lo, float hi) { return lo + (hi - lo) * (float(i) + 0.5f) / float(k); }
+  // The inverse of t = x / (|x| + s).
+  static float expand(float t, float s) { return s * t / (1.0f - std::abs(t)); }
+  static vec3 octahedral_decode(float a, float b) {
+    const float z = 1.0f - std::abs(a) - std::abs(b);
+    if (z >= 0.0f) return {a, b, z};
+    return {std::copysign(1.0f - std::abs(b), a), std::copysign(1.0f - std::abs(a), b), z};
+  }
+
+  vec3 c_{0.0f}, u1_{1, 0, 0}, u2_{0, 1, 0}, nl_{0, 0, 1};
+  float s1_ = 1.0f, s2_ = 1.0f, sh_ = 1.0f;
+  std::shared_ptr<const std::vector<std::uint8_t>> cells_;
+};
+
+}  // namespace mcrt
