@@ -203,7 +203,7 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--auto-rest-cost", ro.auto_rest_cost,
                          "--light-sampling auto: the rest of the path's time per light sample, ns (default 265)");
   render_cmd->add_option("--auto-rest-variance", ro.auto_rest_variance,
-                         "--light-sampling auto: the relative variance the rest of the path adds (default 1)");
+                         "--light-sampling auto: the relative variance the rest of the path adds (default 4)");
   render_cmd->add_option("--ellipse-map", ro.ellipse_map,
                          "Map of the spherical ellipse for ellipses sampled by solid angle (default parallel)")
       ->check(CLI::IsMember({"parallel", "polar"}));

@@ -30,7 +30,7 @@
 // costs from the README's cost tables, c_rest from the error-against-time
 // study (cornell_rect, nee, sobol: ms per spp of area and solid-angle
 // sampling, 318 and 451 ns per path at 1.13 light samples per path, leave
-// 265 ns per light sample for the rest), v_rest = 1 the value, of those
+// 265 ns per light sample for the rest), v_rest = 4 the value, of those
 // tried (0.25, 1, 4, 16), with the best worst case over the study's scenes
 // (README, "Choosing per shading point", which also says how far this rule
 // is from the best fixed strategy).
@@ -69,7 +69,7 @@ namespace mcrt {
 // render --auto-rest-cost --auto-rest-variance` sets them).
 struct auto_params {
   float rest_cost = 265.0f;      // c_rest, ns per light sample
-  float rest_variance = 1.0f;    // v_rest
+  float rest_variance = 4.0f;    // v_rest
 };
 
 // Time per light sample (ns, sample + pdf) of each strategy of a shape.

@@ -30,6 +30,7 @@
 #include <memory>
 #include <vector>
 
+#include "mcrt/core/fast_math.hpp"
 #include "mcrt/core/math.hpp"
 #include "mcrt/sampling/light_sample.hpp"
 
@@ -84,17 +85,19 @@ class planar_auto_table {
     // Reflected into the quadrant x, y >= 0, n with it.
     const float x = std::abs(x0), y = std::abs(y0);
     const float nx = std::copysign(1.0f, x0) * glm::dot(n, u1_), ny = std::copysign(1.0f, y0) * glm::dot(n, u2_);
-    const float nz = glm::dot(n, nl_);
-    const float inv_l1 = 1.0f / (std::abs(nx) + std::abs(ny) + std::abs(nz));
-    float a = nx * inv_l1, b = ny * inv_l1;
+    const float nz = glm::dot(n, nl_), hp = std::max(h, 0.0f);
+    // The four divisions as one packed one.
+    const std::array<float, 4> inv =
+        fast_math::reciprocal4(std::abs(nx) + std::abs(ny) + std::abs(nz), x + s1_, y + s2_, hp + sh_);
+    float a = nx * inv[0], b = ny * inv[0];
     if (nz < 0.0f) {
       const float a0 = a;
       a = std::copysign(1.0f - std::abs(b), a0);
       b = std::copysign(1.0f - std::abs(a0), b);
     }
-    const int ix = cell(x / (x + s1_), lateral_cells, 0.0f, 1.0f);
-    const int iy = cell(y / (y + s2_), lateral_cells, 0.0f, 1.0f);
-    const int ih = cell(std::max(h, 0.0f) / (std::max(h, 0.0f) + sh_), height_cells, 0.0f, 1.0f);
+    const int ix = cell(x * inv[1], lateral_cells, 0.0f, 1.0f);
+    const int iy = cell(y * inv[2], lateral_cells, 0.0f, 1.0f);
+    const int ih = cell(hp * inv[3], height_cells, 0.0f, 1.0f);
     const int ia = cell(a, normal_cells, -1.0f, 1.0f), ib = cell(b, normal_cells, -1.0f, 1.0f);
     return static_cast<light_sampling>((*cells_)[index(ix, iy, ih, ia, ib)]);
   }
