@@ -52,6 +52,15 @@ def make_slice_plots(rows: list[dict], settings: Settings, scenes: list[str]) ->
             axis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
             axis.set_minor_formatter(ticker.NullFormatter())
 
+    def finish_panel(ax, title: str, xlabel: str, ylabel: str) -> None:
+        """Log-log axes, labels, grid and legend of one scene's panel."""
+        log_axes(ax)
+        ax.set_title(title)
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+
     def band_plot(ax, x, key_or_values, strategy, marker="o"):
         mean, lo, hi = key_or_values
         style = STRATEGY_STYLE[strategy]
@@ -77,12 +86,7 @@ def make_slice_plots(rows: list[dict], settings: Settings, scenes: list[str]) ->
                     r0 = mean_curve(st0, "rmse")[0][0]
                     ref_x = st0["spp"]
                     ax.plot(ref_x, r0 * np.sqrt(ref_x[0] / ref_x), "k:", lw=1, label="∝ spp^-1/2")
-            log_axes(ax)
-            ax.set_title(sc)
-            ax.set_xlabel("samples per pixel")
-            ax.set_ylabel(ylabel)
-            ax.grid(True, which="both", alpha=0.3)
-            ax.legend(fontsize=8)
+            finish_panel(ax, sc, "samples per pixel", ylabel)
         save(fig, name, caption)
 
     fig, axes = grid("RMSE against render time")
@@ -95,12 +99,7 @@ def make_slice_plots(rows: list[dict], settings: Settings, scenes: list[str]) ->
             band_plot(ax, t, mean_curve(st, "rmse"), s)
             ax.scatter(np.concatenate(st["seconds"]), np.concatenate(st["rmse"]), s=4,
                        color=STRATEGY_STYLE[s]["color"], alpha=0.35)
-        log_axes(ax)
-        ax.set_title(sc)
-        ax.set_xlabel("render time (s)")
-        ax.set_ylabel("RMSE")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
+        finish_panel(ax, sc, "render time (s)", "RMSE")
     save(fig, "rmse_vs_time.png",
          "RMSE against render time (log-log; line: mean over seeds per spp, band: min–max RMSE, "
          "dots: single renders). Lower-left is better.")
@@ -114,12 +113,7 @@ def make_slice_plots(rows: list[dict], settings: Settings, scenes: list[str]) ->
             eff = [1.0 / (m * t) for m, t in zip(st["mse"], st["seconds"])]
             band_plot(ax, st["spp"], (np.array([e.mean() for e in eff]), np.array([e.min() for e in eff]),
                                       np.array([e.max() for e in eff])), s)
-        log_axes(ax)
-        ax.set_title(sc)
-        ax.set_xlabel("samples per pixel")
-        ax.set_ylabel("1 / (MSE · s)")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
+        finish_panel(ax, sc, "samples per pixel", "1 / (MSE · s)")
     save(fig, "efficiency.png",
          "Efficiency 1/(MSE·time) against spp (mean over seeds, band: min–max). Higher is better; "
          "it should be roughly flat in spp.")
