@@ -436,17 +436,12 @@ class tabulated_planar_rule {
   tabulated_planar_rule(const ellipse& e, const auto_params& p)
       : tabulated_planar_rule(planar_rule(e), e.center, e.a1, e.a2, e.n, p) {}
 
-  // Area behind the light (nothing is sampled there).
-  light_sampling choose(const vec3& o, const vec3& n) const {
-    if (!(glm::dot(o - centre_, nl_) > 0.0f)) return light_sampling::area;
-    return table_.lookup(o, n);
-  }
+  light_sampling choose(const vec3& o, const vec3& n) const { return table_.lookup(o, n); }
 
  private:
   tabulated_planar_rule(const planar_rule& rule, const vec3& c, const vec3& h1, const vec3& h2, const vec3& nl,
                         const auto_params& p)
-      : centre_(c), nl_(nl), table_(c, h1, h2, nl, [&](const vec3& o, const vec3& n) { return rule.choose(o, n, p); }) {}
-  vec3 centre_, nl_;
+      : table_(c, h1, h2, nl, [&](const vec3& o, const vec3& n) { return rule.choose(o, n, p); }) {}
   planar_auto_table table_;
 };
 // Spheres: the rule itself (its early test for caps above the horizon is

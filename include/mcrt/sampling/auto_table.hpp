@@ -77,18 +77,20 @@ class planar_auto_table {
 
   bool empty() const { return !cells_; }
 
-  // The tabulated choice at o (in front of the light: h > 0) for the unit
-  // normal n.
+  // The tabulated choice at o for the unit normal n; area where o is not
+  // in front of the light (h <= 0: nothing is sampled there).
   light_sampling lookup(const vec3& o, const vec3& n) const {
     const vec3 d = o - c_;
-    const float x0 = glm::dot(d, u1_), y0 = glm::dot(d, u2_), h = glm::dot(d, nl_);
+    const float h = glm::dot(d, nl_);
+    if (!(h > 0.0f)) return light_sampling::area;
+    const float x0 = glm::dot(d, u1_), y0 = glm::dot(d, u2_);
     // Reflected into the quadrant x, y >= 0, n with it.
     const float x = std::abs(x0), y = std::abs(y0);
     const float nx = std::copysign(1.0f, x0) * glm::dot(n, u1_), ny = std::copysign(1.0f, y0) * glm::dot(n, u2_);
-    const float nz = glm::dot(n, nl_), hp = std::max(h, 0.0f);
+    const float nz = glm::dot(n, nl_);
     // The four divisions as one packed one.
     const std::array<float, 4> inv =
-        fast_math::reciprocal4(std::abs(nx) + std::abs(ny) + std::abs(nz), x + s1_, y + s2_, hp + sh_);
+        fast_math::reciprocal4(std::abs(nx) + std::abs(ny) + std::abs(nz), x + s1_, y + s2_, h + sh_);
     float a = nx * inv[0], b = ny * inv[0];
     if (nz < 0.0f) {
       const float a0 = a;
@@ -97,7 +99,7 @@ class planar_auto_table {
     }
     const int ix = cell(x * inv[1], lateral_cells, 0.0f, 1.0f);
     const int iy = cell(y * inv[2], lateral_cells, 0.0f, 1.0f);
-    const int ih = cell(hp * inv[3], height_cells, 0.0f, 1.0f);
+    const int ih = cell(h * inv[3], height_cells, 0.0f, 1.0f);
     const int ia = cell(a, normal_cells, -1.0f, 1.0f), ib = cell(b, normal_cells, -1.0f, 1.0f);
     return static_cast<light_sampling>((*cells_)[index(ix, iy, ih, ia, ib)]);
   }
