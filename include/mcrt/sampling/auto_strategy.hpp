@@ -137,7 +137,13 @@ class auto_choice {
   bool area_wins_even_if(float factor, const auto_costs::shape_costs& c, const auto_params& p) const {
     if (!(sg_ > 0.0f)) return true;
     if (peaked()) return false;
-    const float area = (c.area + p.rest_cost) * (factor * v_area() + p.rest_variance);
+    return area_wins(factor * v_area(), c, p);
+  }
+
+  // Whether area sampling with variance v_area beats both other strategies
+  // even at no variance of their own.
+  static bool area_wins(float v_area, const auto_costs::shape_costs& c, const auto_params& p) {
+    const float area = (c.area + p.rest_cost) * (v_area + p.rest_variance);
     return area <= (c.solid_angle + p.rest_cost) * p.rest_variance &&
            area <= (c.projected_solid_angle + p.rest_cost) * p.rest_variance;
   }
@@ -244,12 +250,7 @@ class planar_rule {
   light_sampling choose(const vec3& o, const vec3& n, const auto_params& p) const {
     const auto_costs::shape_costs& c = costs_;
     float v_delta;
-    if (delta_v_area(o, n, v_delta)) {
-      const float area = (c.area + p.rest_cost) * (2.0f * v_delta + p.rest_variance);
-      if (area <= (c.solid_angle + p.rest_cost) * p.rest_variance &&
-          area <= (c.projected_solid_angle + p.rest_cost) * p.rest_variance)
-        return light_sampling::area;
-    }
+    if (delta_v_area(o, n, v_delta) && auto_choice::area_wins(2.0f * v_delta, c, p)) return light_sampling::area;
     if (coarse(o, n).area_wins_even_if(4.0f, c, p)) return light_sampling::area;
     return fine(o, n).choose(c, p);
   }
