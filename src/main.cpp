@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -82,7 +83,11 @@ int run_render(const render_options& opt) {
       throw input_error("--auto-rest-variance: must be a finite number > 0");
     ap.rest_variance = *opt.auto_rest_variance;
   }
-  loaded_scene ls = load_scene(opt.scene, strategy, map, ap);
+  // Unless v_rest is given, `auto` takes it from the image's noise, which a
+  // pilot measures on the scene with those lights sampled by their cheapest
+  // strategy (auto_strategy.hpp, auto_params; render/noise_pilot.hpp).
+  const bool pilot = !opt.auto_rest_variance;
+  loaded_scene ls = load_scene(opt.scene, strategy, map, ap, pilot);
   const std::string output = opt.output.empty() ? ls.name + ".exr" : opt.output;
   check_writable(output, true);
   if (!opt.stats.empty()) check_writable(opt.stats, false);
@@ -106,7 +111,16 @@ int run_render(const render_options& opt) {
   rs.heuristic = opt.mis_heuristic == "balance" ? mis_heuristic::balance : mis_heuristic::power;
   rs.choose = opt.light_select == "uniform" ? light_choice::uniform : light_choice::power;
 
-  const render_result res = render_scene(ls.world, cam, rs, opt.quiet ? progress_callback{} : progress_callback(print_progress));
+  std::optional<noise_pilot_result> noise;
+  if (pilot && ls.auto_lights > 0) {
+    noise = estimate_image_variance(ls.world, cam, rs);
+    // A noise-free pilot leaves nothing for a cheaper strategy to hide in.
+    ap.image_variance = std::max(static_cast<float>(noise->image_variance), std::numeric_limits<float>::min());
+    ls = load_scene(opt.scene, strategy, map, ap);
+  }
+
+  render_result res = render_scene(ls.world, cam, rs, opt.quiet ? progress_callback{} : progress_callback(print_progress));
+  if (noise) res.seconds += noise->seconds;  // the pilot is part of the image's time
   const double samples = static_cast<double>(rs.width) * rs.height * rs.spp;
   const std::string strategy_used = strategy_summary(ls.world);
   if (res.nonfinite_samples && !opt.quiet)
@@ -141,6 +155,10 @@ int run_render(const render_options& opt) {
     j["rr_depth"] = rs.rr_depth;
     j["scene"] = ls.name;
     j["nonfinite_samples"] = res.nonfinite_samples;
+    if (noise) {
+      j["auto_pilot_seconds"] = noise->seconds;
+      j["auto_image_variance"] = noise->image_variance;
+    }
     write_text(opt.stats, j.dump(2) + "\n");
   }
   return 0;
@@ -203,7 +221,8 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--auto-rest-cost", ro.auto_rest_cost,
                          "--light-sampling auto: the rest of the path's time per light sample, ns (default 265)");
   render_cmd->add_option("--auto-rest-variance", ro.auto_rest_variance,
-                         "--light-sampling auto: the relative variance the rest of the path adds (default 4)");
+                         "--light-sampling auto: the relative variance the rest of the path adds, one value everywhere "
+                         "(default: from the image's noise, measured by a pilot of about 1024 pixels x 2 samples)");
   render_cmd->add_option("--ellipse-map", ro.ellipse_map,
                          "Map of the spherical ellipse for ellipses sampled by solid angle (default parallel)")
       ->check(CLI::IsMember({"parallel", "polar"}));

@@ -256,7 +256,8 @@ constexpr const char* strategy_names = "area, solid-angle, projected-solid-angle
 
 void read_object(const reader& rd, const json& o, const std::string& path, scene& world,
                  const std::map<std::string, std::uint32_t>& material_ids,
-                 std::optional<light_sampling> override_strategy, ellipse_map map, const auto_params& ap) {
+                 std::optional<light_sampling> override_strategy, ellipse_map map, const auto_params& ap,
+                 bool auto_pilot, int& auto_lights) {
   if (!o.is_object()) rd.ctx.fail(path, std::string("expected an object, got ") + type_name(o));
   std::string type = rd.string(o, path, "type");
   const std::string mat_name = rd.string(o, path, "material");
@@ -293,10 +294,25 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
   if (override_strategy && is_light) strategy = *override_strategy;
 
   auto add = [&](const auto& shape) {
-    if (sampled)
-      add_light(world, shape, mat, strategy, map, ap);
-    else
+    if (!sampled) {
       world.add(shape, mat);
+      return;
+    }
+    if (strategy == light_sampling::automatic && is_light) {
+      ++auto_lights;
+      // The noise pilot's scene: the shape's default strategy (its cheapest).
+      if (auto_pilot) {
+        add_light(world, shape, mat, std::nullopt, map, ap);
+        return;
+      }
+      // The light's radiance (the mean of its channels) for the rule's v_rest.
+      auto_params lp = ap;
+      const color e = std::get<diffuse_light>(world.materials[mat]).emit;
+      lp.radiance = (e.r + e.g + e.b) / 3.0f;
+      add_light(world, shape, mat, strategy, map, lp);
+      return;
+    }
+    add_light(world, shape, mat, strategy, map, ap);
   };
 
   if (type == "xz_rect" || type == "xy_rect" || type == "yz_rect") {
@@ -348,7 +364,7 @@ std::optional<light_sampling> parse_light_sampling_flag(const std::string& value
 }
 
 loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy, ellipse_map map,
-                        const auto_params& ap) {
+                        const auto_params& ap, bool auto_pilot) {
   const context ctx{path};
   const reader rd{ctx};
   std::ifstream in(path, std::ios::binary);
@@ -400,7 +416,8 @@ loaded_scene load_scene(const std::string& path, std::optional<light_sampling> o
   if (!objs.is_array()) ctx.fail("objects", std::string("expected an array, got ") + type_name(objs));
   if (objs.empty()) ctx.fail("objects", "the scene has no objects");
   for (std::size_t i = 0; i < objs.size(); ++i)
-    read_object(rd, objs[i], "objects[" + std::to_string(i) + "]", out.world, ids, override_strategy, map, ap);
+    read_object(rd, objs[i], "objects[" + std::to_string(i) + "]", out.world, ids, override_strategy, map, ap, auto_pilot,
+                out.auto_lights);
 
   // Self-intersection guard proportional to the scene's coordinates: a few
   // thousand float ulps of the largest coordinate (1.1e-3 for the 555-unit

@@ -31,6 +31,7 @@ struct loaded_scene {
   scene world;
   camera_desc cam;
   int spp = 100, max_depth = 50;
+  int auto_lights = 0;  // lights sampled by `auto`
 };
 
 // Which area-preserving map of the spherical ellipse samples an ellipse by
@@ -46,8 +47,11 @@ std::optional<light_sampling> parse_light_sampling_flag(const std::string& value
 // strategy; non-emitting sampled objects keep their own.
 // map: --ellipse-map; the map of every ellipse sampled by solid angle.
 // ap: the parameters of every light sampled by `auto` (--auto-rest-cost,
-// --auto-rest-variance).
+// --auto-rest-variance, and the image's variance its noise pilot measured),
+// each with its own light's radiance.
+// auto_pilot: the scene for that pilot: every light that would be sampled by
+// `auto` takes its shape's default (cheapest) strategy instead.
 loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy = std::nullopt,
-                        ellipse_map map = ellipse_map::parallel, const auto_params& ap = {});
+                        ellipse_map map = ellipse_map::parallel, const auto_params& ap = {}, bool auto_pilot = false);
 
 }  // namespace mcrt::cli

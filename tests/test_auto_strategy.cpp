@@ -7,12 +7,16 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <numbers>
+#include <type_traits>
 #include <string>
 #include <vector>
 
 #include "mcrt/core/rng.hpp"
 #include "mcrt/sampling/auto_strategy.hpp"
 #include "support/chi2.hpp"
+#include "support/lambert.hpp"
 #include "support/solid_angle.hpp"
 
 namespace {
@@ -170,8 +174,8 @@ TEST(AutoStrategy, PlainChoices) {
 // 0, at most 1e-3 of the samples). 20000 random receivers (position and
 // normal) around each shape; every strategy gets chosen somewhere.
 template <class Auto, class Shape>
-void check_agreement(const Shape& shape) {
-  const Auto s(shape);
+void check_agreement(const Shape& shape, const auto_params& params = {}, bool area_expected = true) {
+  const Auto s(shape, params);
   pcg32 rng(21, 5);
   int chosen[3] = {0, 0, 0}, sampled = 0, off = 0;
   for (int i = 0; i < 20000; ++i) {
@@ -215,7 +219,7 @@ void check_agreement(const Shape& shape) {
   }
   EXPECT_GT(sampled, 1000);
   EXPECT_LE(off, sampled / 1000) << "samples off the light by rounding";
-  for (int k = 0; k < 3; ++k) EXPECT_GT(chosen[k], 0) << "strategy " << k << " never chosen";
+  for (int k = area_expected ? 0 : 1; k < 3; ++k) EXPECT_GT(chosen[k], 0) << "strategy " << k << " never chosen";
 }
 
 TEST(AutoStrategy, PdfAgreesRect) { check_agreement<rect_auto_sampler>(xz_rect(-1.0f, 1.0f, -0.8f, 0.8f, 0.0f, true)); }
@@ -223,6 +227,96 @@ TEST(AutoStrategy, PdfAgreesDisk) {
   check_agreement<ellipse_auto_sampler>(ellipse::make({0, 0, 0}, {1.0f, 0, 0}, {0, 0, 0.8f}));
 }
 TEST(AutoStrategy, PdfAgreesSphere) { check_agreement<sphere_auto_sampler>(sphere{vec3(0.0f, 0.6f, 0.0f), 0.5f}); }
+// The same with v_rest from the image's noise (V = 0.01, L = 1).
+auto_params noise_params(float v = 0.01f) {
+  auto_params p;
+  p.image_variance = v;
+  p.radiance = 1.0f;
+  return p;
+}
+TEST(AutoStrategy, PdfAgreesRectImageNoise) {
+  check_agreement<rect_auto_sampler>(xz_rect(-1.0f, 1.0f, -0.8f, 0.8f, 0.0f, true), noise_params());
+}
+TEST(AutoStrategy, PdfAgreesDiskImageNoise) {
+  check_agreement<ellipse_auto_sampler>(ellipse::make({0, 0, 0}, {1.0f, 0, 0}, {0, 0, 0.8f}), noise_params());
+}
+TEST(AutoStrategy, PdfAgreesSphereImageNoise) {
+  // Area sampling of a sphere (dearer than its cone, and noisier where
+  // the cap's cosine varies little) is not chosen at these receivers.
+  check_agreement<sphere_auto_sampler>(sphere{vec3(0.0f, 0.6f, 0.0f), 0.5f}, noise_params(), false);
+}
+
+// v_rest from the image's noise: V / (L Omega_proj / pi)^2, infinite where
+// the light gives nothing; the fixed v_rest where no noise is given.
+TEST(AutoStrategy, RestVarianceFromTheImagesNoise) {
+  auto_params p;
+  EXPECT_EQ(p.rest_variance_at(0.3f), p.rest_variance);
+  p.image_variance = 0.5f;
+  p.radiance = 10.0f;
+  const float d = 10.0f * 0.3f / std::numbers::pi_v<float>;
+  EXPECT_NEAR(p.rest_variance_at(0.3f), 0.5f / (d * d), 1e-6f);
+  EXPECT_EQ(p.rest_variance_at(0.0f), std::numeric_limits<float>::infinity());
+  // The models' projected solid angle: the quadrature's, against the
+  // closed forms (Lambert's formula for the rectangle, the cap's).
+  const rect r = xz_rect(-1.0f, 1.0f, -0.8f, 0.8f, 0.0f, true);
+  const vec3 o{0.4f, -1.5f, 0.2f}, up{0, 1, 0};
+  const std::vector<glm::dvec3> poly{{-1, 0, -0.8}, {1, 0, -0.8}, {1, 0, 0.8}, {-1, 0, 0.8}};
+  const double exact_rect = test::polygon_irradiance(glm::dvec3(o), {0, 1, 0}, poly, 1.0);  // = Omega_proj
+  EXPECT_NEAR(auto_model(r, o, up).omega_proj(), exact_rect, 0.02 * exact_rect);
+  const sphere sp{vec3(0.0f, 2.0f, 0.0f), 0.5f};
+  const double sin2 = 0.25 / 4.0, exact_cap = std::numbers::pi * sin2;  // cap straight above: cos(theta_c) = 1
+  EXPECT_NEAR(auto_model(sp, vec3(0.0f), up).omega_proj(), exact_cap, 0.02 * exact_cap);
+}
+
+// As the image's noise grows, v_rest grows at every point and the choice
+// never moves to a dearer strategy (the rule takes the least of lines in
+// v_rest whose slopes are the strategies' costs); with no noise left to
+// hide in, near receivers leave area sampling; with infinite noise, every
+// point takes its shape's cheapest strategy.
+template <class Shape>
+void check_monotone(const Shape& shape, bool sphere_shape) {
+  pcg32 rng(41, 3);
+  const std::vector<float> noise{1e-6f, 1e-4f, 1e-2f, 1.0f, 1e2f, 1e4f, 1e30f};
+  int moved = 0, near_not_area = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const float dist = 0.3f + 6.0f * rng.uniform();
+    const vec3 dir = glm::normalize(vec3(2 * rng.uniform() - 1, -rng.uniform() - 0.05f, 2 * rng.uniform() - 1));
+    const vec3 o = dist * dir;
+    const vec3 n = glm::normalize(vec3(2 * rng.uniform() - 1, 2 * rng.uniform() - 0.3f, 2 * rng.uniform() - 1));
+    auto cost = [&](light_sampling c) {
+      auto_costs::shape_costs k = auto_costs::rect;
+      if constexpr (std::is_same_v<Shape, ellipse>) k = auto_costs::ellipse;
+      if constexpr (std::is_same_v<Shape, sphere>) {
+        const vec3 v = shape.center - o;
+        k = glm::dot(v, n) >= shape.radius ? auto_costs::sphere_above : auto_costs::sphere_crossing;
+      }
+      return c == light_sampling::area ? k.area : c == light_sampling::solid_angle ? k.solid_angle : k.projected_solid_angle;
+    };
+    float last = std::numeric_limits<float>::infinity();
+    light_sampling first{};
+    for (std::size_t j = 0; j < noise.size(); ++j) {
+      const light_sampling c = choose_strategy(shape, o, n, noise_params(noise[j]));
+      if (j == 0) first = c;
+      ASSERT_LE(cost(c), last) << "receiver " << i << ", V = " << noise[j];
+      if (cost(c) < last && j > 0) ++moved;
+      last = cost(c);
+      if (j + 1 == noise.size())
+        EXPECT_EQ(c, sphere_shape ? light_sampling::solid_angle : light_sampling::area) << "receiver " << i;
+    }
+    if (dist < 1.0f && first != light_sampling::area) ++near_not_area;
+  }
+  EXPECT_GT(moved, 400) << "the choice must depend on the noise";
+  EXPECT_GT(near_not_area, 100);
+}
+TEST(AutoStrategy, NeverDearerAsTheImageGetsNoisierRect) {
+  check_monotone(xz_rect(-1.0f, 1.0f, -0.8f, 0.8f, 0.0f, true), false);
+}
+TEST(AutoStrategy, NeverDearerAsTheImageGetsNoisierDisk) {
+  check_monotone(ellipse::make({0, 0, 0}, {1.0f, 0, 0}, {0, 0, 0.8f}), false);
+}
+TEST(AutoStrategy, NeverDearerAsTheImageGetsNoisierSphere) {
+  check_monotone(sphere{vec3(0.0f, 0.6f, 0.0f), 0.5f}, true);
+}
 
 // Chi-square of the auto strategy's directions at receivers where each
 // strategy is the one chosen (1e6 samples each).
@@ -299,8 +393,8 @@ TEST(AutoTable, ReproducesARuleAlignedWithItsCells) {
 // rectangle and a disk (as check_agreement's): the same choice at most of
 // them (they differ only in cells the rule's boundary crosses).
 template <class Auto, class Shape>
-double tabulated_agreement(const Shape& shape) {
-  const Auto s(shape);
+double tabulated_agreement(const Shape& shape, const auto_params& params = {}) {
+  const Auto s(shape, params);
   pcg32 rng(31, 7);
   int same = 0;
   const int count = 20000;
@@ -319,6 +413,11 @@ TEST(AutoTable, AgreesWithTheRuleAtMostReceivers) {
       tabulated_agreement<ellipse_auto_sampler>(ellipse::make({0, 0, 0}, {1.0f, 0, 0}, {0, 0, 0.8f}));
   EXPECT_GE(rect_share, 0.9);
   EXPECT_GE(disk_share, 0.9);
+  // With v_rest from the image's noise (it varies with the light's
+  // projected solid angle, which the cells resolve as they resolve v_area).
+  EXPECT_GE(tabulated_agreement<rect_auto_sampler>(xz_rect(-1.0f, 1.0f, -0.8f, 0.8f, 0.0f, true), noise_params()), 0.9);
+  EXPECT_GE(tabulated_agreement<ellipse_auto_sampler>(ellipse::make({0, 0, 0}, {1.0f, 0, 0}, {0, 0, 0.8f}), noise_params()),
+            0.9);
   ::testing::Test::RecordProperty("rect_share", std::to_string(rect_share));
   ::testing::Test::RecordProperty("disk_share", std::to_string(disk_share));
   std::printf("tabulated = rule at %.3f (rectangle), %.3f (disk) of the receivers\n", rect_share, disk_share);

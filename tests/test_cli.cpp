@@ -325,6 +325,29 @@ TEST_F(Cli, PerLightSamplingField) {
   EXPECT_EQ(nlohmann::json::parse(slurp(stats))["light_sampling"], "auto");
 }
 
+// `auto` measures the image's noise by a pilot unless --auto-rest-variance
+// fixes v_rest; the stats say so, and its time is part of render_seconds.
+TEST_F(Cli, AutoNoisePilotInStats) {
+  const std::string floor = R"({"type": "xz_rect", "x0": -5, "x1": 5, "z0": -5, "z1": 5, "k": 0, "material": "white"})";
+  const std::string lamp = R"({"type": "xz_rect", "x0": -0.5, "x1": 0.5, "z0": -0.5, "z1": 0.5, "k": 2, "material": "light", "flip": true})";
+  const fs::path s = write("lamp.json", scene_with(floor + ", " + lamp));
+  const fs::path out = dir / "o.exr", stats = dir / "s.json";
+  const std::string base = "render " + s.string() + " -o " + out.string() + " --stats " + stats.string() + " --quiet ";
+  ASSERT_EQ(run(base + "--light-sampling auto").status, 0);
+  auto j = nlohmann::json::parse(slurp(stats));
+  ASSERT_TRUE(j.contains("auto_pilot_seconds"));
+  ASSERT_TRUE(j.contains("auto_image_variance"));
+  EXPECT_GT(j["auto_image_variance"].get<double>(), 0.0);
+  EXPECT_LE(j["auto_pilot_seconds"].get<double>(), j["render_seconds"].get<double>());
+  for (const char* flags : {"--light-sampling auto --auto-rest-variance 4", "--light-sampling area", ""}) {
+    ASSERT_EQ(run(base + flags).status, 0) << flags;
+    j = nlohmann::json::parse(slurp(stats));
+    EXPECT_FALSE(j.contains("auto_pilot_seconds")) << flags;
+  }
+  expect_bad("render " + s.string() + " -o " + out.string() + " --light-sampling auto --auto-rest-variance 0",
+             {"--auto-rest-variance"}, out);
+}
+
 // mcrt samples: the CSV of the contract, to a file or to stdout; samples on
 // the light with their pdf, rows of pdf 0 where the light faces away; bad
 // arguments refused with one line and exit 2, the output untouched.

@@ -42,6 +42,7 @@
 // once per cell of a table of receiver positions and normals
 // (auto_table.hpp), so a shading point pays a lookup, not the rule.
 #include <algorithm>
+#include <limits>
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
@@ -67,9 +68,37 @@ namespace mcrt {
 // The two parameters of the rule that describe the rest of the renderer
 // rather than the light (the defaults: the header's measurements; `mcrt
 // render --auto-rest-cost --auto-rest-variance` sets them).
+//
+// v_rest either is one number for every point (rest_variance), or follows
+// from the image's noise (image_variance > 0): the image's error is
+// minimised for its time where each light sample takes the strategy with
+// the least t_s / t + D^2 v_s / V (first order in the change of the
+// product error x time; t the time per light sample, D the light's
+// contribution to the pixel, V the image's mean variance per sample and
+// pixel), which is the product rule with v_rest = V / D^2 at the point.
+// D is taken as a white diffuse receiver's radiance, L Omega_proj / pi,
+// with L the light's radiance (radiance) and Omega_proj its projected
+// solid angle at the point: close to a bright light, where its own noise
+// would dominate the pixel, v_rest is small and the dearer strategies
+// pay; where the image's noise is elsewhere (the edges of a light seen by
+// the camera, shadows, indirect light), v_rest is large and area sampling
+// is kept. `mcrt render` measures V by a pilot (render/noise_pilot.hpp).
 struct auto_params {
   float rest_cost = 265.0f;      // c_rest, ns per light sample
-  float rest_variance = 4.0f;    // v_rest
+  float rest_variance = 4.0f;    // v_rest, where image_variance is 0
+  float image_variance = 0.0f;   // V: mean variance of a pixel sample (radiance^2); 0: use rest_variance
+  float radiance = 1.0f;         // L: the light's radiance (mean of its channels)
+
+  // v_rest at a point where the light's projected solid angle is omega_proj
+  // (infinite where the light gives nothing: no strategy helps there; also
+  // beyond 1e30, where the rule's products (cost + c_rest)(v + v_rest)
+  // would overflow and every strategy's v is negligible anyway).
+  float rest_variance_at(float omega_proj) const {
+    if (!(image_variance > 0.0f)) return rest_variance;
+    const float d = radiance * omega_proj * inv_pi;
+    const float v = image_variance / (d * d);
+    return v < 1e30f ? v : std::numeric_limits<float>::infinity();
+  }
 };
 
 // Time per light sample (ns, sample + pdf) of each strategy of a shape.
@@ -111,6 +140,13 @@ class auto_choice {
     sg_ = sg, sg2_ = sg2, sw_ = sw, swc_ = swc, swc2_ = swc2, g_peak_ = g_peak;
   }
 
+  // The light's projected solid angle at the point is the quadrature's mean
+  // of g times the area the points cover (area_scale; for a planar light
+  // its area times the receiver's height, h being left out of the sums).
+  void set_area_scale(float area_scale) { omega_proj_ = area_scale * sg_; }
+  float omega_proj() const { return omega_proj_; }
+  float rest_variance(const auto_params& p) const { return p.rest_variance_at(omega_proj_); }
+
   // Relative variances of the area and solid-angle estimates (header).
   // v_area: the quadrature's, unless g at the light's nearest point exceeds
   // twice the quadrature's mean: then the receiver is close to the light
@@ -137,22 +173,30 @@ class auto_choice {
   bool area_wins_even_if(float factor, const auto_costs::shape_costs& c, const auto_params& p) const {
     if (!(sg_ > 0.0f)) return true;
     if (peaked()) return false;
-    return area_wins(factor * v_area(), c, p);
+    return area_wins(factor * v_area(), rest_variance(p), c, p);
   }
 
   // Whether area sampling with variance v_area beats both other strategies
-  // even at no variance of their own.
-  static bool area_wins(float v_area, const auto_costs::shape_costs& c, const auto_params& p) {
-    const float area = (c.area + p.rest_cost) * (v_area + p.rest_variance);
-    return area <= (c.solid_angle + p.rest_cost) * p.rest_variance &&
-           area <= (c.projected_solid_angle + p.rest_cost) * p.rest_variance;
+  // even at no variance of their own, v_rest being vr.
+  static bool area_wins(float v_area, float vr, const auto_costs::shape_costs& c, const auto_params& p) {
+    if (vr == std::numeric_limits<float>::infinity()) return cheapest(c) == light_sampling::area;
+    const float area = (c.area + p.rest_cost) * (v_area + vr);
+    return area <= (c.solid_angle + p.rest_cost) * vr && area <= (c.projected_solid_angle + p.rest_cost) * vr;
+  }
+
+  // The cheapest strategy: the choice where v_rest is infinite (the light
+  // gives the point nothing, or the image's noise is all elsewhere).
+  static light_sampling cheapest(const auto_costs::shape_costs& c) {
+    if (c.area <= c.solid_angle && c.area <= c.projected_solid_angle) return light_sampling::area;
+    return c.solid_angle <= c.projected_solid_angle ? light_sampling::solid_angle : light_sampling::projected_solid_angle;
   }
 
   // The strategy with the least modelled (cost + c_rest)(variance + v_rest);
-  // area where no quadrature point is lit (nothing to gain, cheapest).
+  // the cheapest where no quadrature point is lit (nothing to gain).
   light_sampling choose(const auto_costs::shape_costs& c, const auto_params& p = {}) const {
-    if (!(sg_ > 0.0f)) return light_sampling::area;
-    const float cr = p.rest_cost, vr = p.rest_variance;
+    if (!(sg_ > 0.0f)) return cheapest(c);
+    const float cr = p.rest_cost, vr = rest_variance(p);
+    if (vr == std::numeric_limits<float>::infinity()) return cheapest(c);
     const float area = (c.area + cr) * (v_area() + vr);
     const float sa = (c.solid_angle + cr) * (v_solid_angle() + vr);
     const float psa = (c.projected_solid_angle + cr) * vr;
@@ -163,6 +207,7 @@ class auto_choice {
  private:
   vec3 o_, n_;
   float sg_ = 0.0f, sg2_ = 0.0f, sw_ = 0.0f, swc_ = 0.0f, swc2_ = 0.0f, g_peak_ = 0.0f;
+  float omega_proj_ = 0.0f;
 };
 
 // The rule of a planar light (rectangle or ellipse), with what depends on
@@ -181,7 +226,7 @@ class planar_rule {
 
   explicit planar_rule(const rect& r, const auto_costs::shape_costs& c = auto_costs::rect)
       : costs_(c), center_(r.corner + 0.5f * (r.e1 + r.e2)), E1_(r.e1), E2_(r.e2), nl_(r.n), k_(1.0f / 12.0f),
-        rect_(true), corner_(r.corner), dual1_(r.e1_dual), dual2_(r.e2_dual) {
+        area_(glm::length(glm::cross(r.e1, r.e2))), rect_(true), corner_(r.corner), dual1_(r.e1_dual), dual2_(r.e2_dual) {
     // Coarse: 2x2 Gauss points, 1/2 -+ 1/(2 sqrt 3). Fine: 3x3 Gauss-Legendre
     // points (exact for degree 5 in each coordinate), 1/2 -+ sqrt(3/5)/2 and
     // 1/2, weights 5/18, 8/18, 5/18; three padding points of weight 0.
@@ -197,7 +242,8 @@ class planar_rule {
     for (; k < fine_points; ++k) set(fine_, k, center_, 0.0f);
   }
   explicit planar_rule(const ellipse& e, const auto_costs::shape_costs& c = auto_costs::ellipse)
-      : costs_(c), center_(e.center), E1_(e.a1), E2_(e.a2), nl_(e.n), k_(0.25f), rect_(false),
+      : costs_(c), center_(e.center), E1_(e.a1), E2_(e.a2), nl_(e.n), k_(0.25f),
+        area_(pi * glm::length(e.a1) * glm::length(e.a2)), rect_(false),
         corner_(e.center), dual1_(e.a1_dual), dual2_(e.a2_dual) {
     // Coarse: one ring of four points at rho = 1/sqrt(2). Fine: three rings
     // by area (rho^2 = 1/2 -+ sqrt(3/5)/2 and 1/2, the 3-point Gauss rule in
@@ -224,9 +270,14 @@ class planar_rule {
   // across the light, so that the first-order term is all that matters
   // (within a factor 2 on the test receivers: tests/test_auto_strategy.cpp).
   // One division: the gradient's parts over the common denominator
-  // (n . d) r^2.
+  // (n . d) r^2. omega_proj: the light's area times g at its centre.
   bool delta_v_area(const vec3& o, const vec3& n, float& v_area) const {
-    if (!(glm::dot(o - center_, nl_) > 0.0f)) return false;  // behind the light
+    float omega_proj;
+    return delta_v_area(o, n, v_area, omega_proj);
+  }
+  bool delta_v_area(const vec3& o, const vec3& n, float& v_area, float& omega_proj) const {
+    const float h = glm::dot(o - center_, nl_);
+    if (!(h > 0.0f)) return false;  // behind the light
     const vec3 d = center_ - o;
     const float r2 = glm::dot(d, d), nd = glm::dot(n, d);
     if (!(nd > 0.0f) || !(r2 > 0.0f)) return false;
@@ -237,6 +288,7 @@ class planar_rule {
     const float inv = 1.0f / (nd * r2);
     const float g1 = (n1 * r2 - d1 * nd) * inv, g2 = (n2 * r2 - d2 * nd) * inv;
     v_area = k_ * (g1 * g1 + g2 * g2);
+    omega_proj = area_ * h * nd / (r2 * r2);  // A g(centre) = A h (n . d) / r^4
     return true;
   }
 
@@ -249,8 +301,10 @@ class planar_rule {
   // that is the choice; otherwise the fine rule decides.
   light_sampling choose(const vec3& o, const vec3& n, const auto_params& p) const {
     const auto_costs::shape_costs& c = costs_;
-    float v_delta;
-    if (delta_v_area(o, n, v_delta) && auto_choice::area_wins(2.0f * v_delta, c, p)) return light_sampling::area;
+    float v_delta, omega_delta;
+    if (delta_v_area(o, n, v_delta, omega_delta) &&
+        auto_choice::area_wins(2.0f * v_delta, p.rest_variance_at(omega_delta), c, p))
+      return light_sampling::area;
     if (coarse(o, n).area_wins_even_if(4.0f, c, p)) return light_sampling::area;
     return fine(o, n).choose(c, p);
   }
@@ -350,12 +404,14 @@ class planar_rule {
     s.g_max = 0.0f;
     accumulate4(px, py, pz, zero, o, n, s);
     ch.set_sums(s.sg, s.sg2, s.sw, s.sg, s.swc2, std::max(s.g_max, g_quad_max));
+    ch.set_area_scale(area_ * h);
     return ch;
   }
 
   auto_costs::shape_costs costs_;
   vec3 center_, E1_, E2_, nl_;
   float k_;
+  float area_;  // the light's area
   bool rect_;
   vec3 corner_, dual1_, dual2_;  // rect: corner and e_i / |e_i|^2; ellipse: centre and a_i / |a_i|^2
   points<coarse_points> coarse_;
@@ -383,6 +439,7 @@ inline auto_choice auto_model(const sphere& s, const vec3& o, const vec3& n) {
       ch.add(p, glm::dot(o - p, m) / glm::length(o - p), 0.125f);
     }
   }
+  ch.set_area_scale(2.0f * pi * s.radius * s.radius * (1.0f - s.radius / d));  // the visible cap's area
   return ch;
 }
 
@@ -420,8 +477,10 @@ inline light_sampling choose_strategy(const sphere& s, const vec3& o, const vec3
   const auto_costs::shape_costs& c = above ? auto_costs::sphere_above : auto_costs::sphere_crossing;
   if (above) {
     const float v_sa = r2 * (d2 - h * h) / (4.0f * d2 * h * h);  // tan^2(theta_c) sin^2(alpha) / 4
-    if ((c.solid_angle + p.rest_cost) * (2.0f * v_sa + p.rest_variance) <=
-        (c.projected_solid_angle + p.rest_cost) * p.rest_variance)
+    // Omega_proj = pi sin^2(alpha) cos(theta_c) for a cap above the horizon.
+    const float vr = p.rest_variance_at(pi * r2 / d2 * h / std::sqrt(d2));
+    if (vr == std::numeric_limits<float>::infinity() ||
+        (c.solid_angle + p.rest_cost) * (2.0f * v_sa + vr) <= (c.projected_solid_angle + p.rest_cost) * vr)
       return light_sampling::solid_angle;
   }
   return auto_model(s, o, n).choose(c, p);

@@ -1,0 +1,121 @@
+#pragma once
+// The image's noise, measured before rendering: the mean over pixels of the
+// variance of one pixel sample (radiance^2, averaged over the channels),
+// the V of `auto` (sampling/auto_strategy.hpp, auto_params::image_variance).
+//
+// A pilot renders a regular subset of the image's own pixels (every
+// stride-th pixel in x and y, the stride chosen to give about `pixels` of
+// them), at the image's resolution, so that each pixel's footprint, and
+// with it the noise of edges (a light seen by the camera), is the image's;
+// each pixel takes `spp` independent samples with the scene's integrator,
+// and its variance is the unbiased sample variance of those. The mean over
+// the pixels is then an unbiased estimate of the image's mean variance per
+// sample with independent samples (quasi-random samples converge faster
+// where the integrand is smooth; the pilot does not model that).
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <thread>
+#include <vector>
+
+#include "mcrt/render/camera.hpp"
+#include "mcrt/render/renderer.hpp"
+#include "mcrt/samplers/independent.hpp"
+
+namespace mcrt {
+
+struct noise_pilot_settings {
+  int pixels = 1024;  // about this many pixels of the image (all, for smaller images)
+  int spp = 2;        // samples per pixel (>= 2: a sample variance needs two)
+};
+
+struct noise_pilot_result {
+  double image_variance = 0.0;  // mean variance of one pixel sample, radiance^2
+  double seconds = 0.0;         // wall-clock time of the pilot
+  int pixels = 0;               // pixels measured
+  int stride = 1;
+};
+
+// Every stride-th pixel in each direction, stride = floor(sqrt(W H / pixels))
+// (at least 1), starting half a stride in.
+inline int noise_pilot_stride(int width, int height, int pixels) {
+  const double k = std::sqrt(static_cast<double>(width) * height / std::max(pixels, 1));
+  return std::max(1, static_cast<int>(k));
+}
+
+template <class Integrator, class Scene>
+noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& cam, const render_settings& rs,
+                                                const noise_pilot_settings& ps = {}) {
+  noise_pilot_result out;
+  const int m = std::max(ps.spp, 2);
+  out.stride = noise_pilot_stride(rs.width, rs.height, ps.pixels);
+  const int k = out.stride, x0 = k / 2, y0 = k / 2;
+  const int nx = (rs.width - x0 + k - 1) / k, ny = (rs.height - y0 + k - 1) / k;
+  // Its own seed: the pilot's samples are not the image's.
+  const independent_sampler sampler(rs.seed ^ 0x70696c6f74ull, m);  // "pilot"
+  const float inv_w = 1.0f / static_cast<float>(rs.width), inv_h = 1.0f / static_cast<float>(rs.height);
+  const path_settings set = rs.path();
+
+  unsigned n = rs.threads ? rs.threads : std::max(1u, std::thread::hardware_concurrency());
+  n = std::max(1u, std::min<unsigned>(n, static_cast<unsigned>(ny)));
+  // Per row, summed in row order afterwards: the result does not depend on
+  // which thread took which row (the choices of `auto` depend on it).
+  std::atomic<int> next_row{0};
+  std::vector<double> row_sums(static_cast<std::size_t>(ny), 0.0);
+  std::vector<int> row_counts(static_cast<std::size_t>(ny), 0);
+  auto worker = [&] {
+    std::vector<glm::dvec3> c(static_cast<std::size_t>(m));
+    for (int j; (j = next_row.fetch_add(1, std::memory_order_relaxed)) < ny;) {
+      const int y = y0 + j * k;
+      double sum = 0.0;
+      int count = 0;
+      for (int i = 0; i < nx; ++i) {
+        const int x = x0 + i * k;
+        auto px = sampler.start_pixel(x, y, rs.width);
+        int finite = 0;
+        glm::dvec3 mean(0.0);
+        for (int s = 0; s < m; ++s) {
+          px.start_sample(s);
+          const vec2 jit = px.pixel();
+          const ray r = cam.generate((static_cast<float>(x) + jit.x) * inv_w, (static_cast<float>(y) + jit.y) * inv_h);
+          const color v = Integrator::li(sc, r, px, set);
+          if (!all_finite(v)) continue;
+          c[static_cast<std::size_t>(finite++)] = glm::dvec3(v);
+          mean += glm::dvec3(v);
+        }
+        if (finite < 2) continue;
+        mean /= static_cast<double>(finite);
+        glm::dvec3 ss(0.0);
+        for (int s = 0; s < finite; ++s) ss += (c[static_cast<std::size_t>(s)] - mean) * (c[static_cast<std::size_t>(s)] - mean);
+        sum += (ss.x + ss.y + ss.z) / (3.0 * (finite - 1));
+        ++count;
+      }
+      row_sums[static_cast<std::size_t>(j)] = sum;
+      row_counts[static_cast<std::size_t>(j)] = count;
+    }
+  };
+
+  const auto start = std::chrono::steady_clock::now();
+  {
+    std::vector<std::jthread> pool;
+    for (unsigned t = 1; t < n; ++t) pool.emplace_back(worker);
+    worker();
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  double sum = 0.0;
+  for (int j = 0; j < ny; ++j) sum += row_sums[static_cast<std::size_t>(j)], out.pixels += row_counts[static_cast<std::size_t>(j)];
+  out.image_variance = out.pixels ? sum / out.pixels : 0.0;
+  return out;
+}
+
+// With the integrator named in rs (the pilot's sampler is always independent).
+template <class Scene>
+noise_pilot_result estimate_image_variance(const Scene& sc, const camera& cam, const render_settings& rs,
+                                           const noise_pilot_settings& ps = {}) {
+  return with_integrator(rs.integrator,
+                         [&]<class I>() { return estimate_image_variance_with<I>(sc, cam, rs, ps); });
+}
+
+}  // namespace mcrt

@@ -1,0 +1,129 @@
+// The noise pilot (render/noise_pilot.hpp): the image's mean variance of one
+// pixel sample, the V of `auto`.
+//
+// Statistics: the pilot is an unbiased estimate for any number of samples
+// per pixel (>= 2); 200 pilots of 2 samples per pixel (independent seeds)
+// are compared with one of 256 samples per pixel on the same pixels, the
+// check being |mean of the 200 - the 256-sample value| <= 5 standard
+// errors of that difference (two-sided false-failure probability 6e-7,
+// normal approximation: the mean of 200 such estimates is close to normal).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "mcrt/mcrt.hpp"
+
+using namespace mcrt;
+
+namespace {
+
+// A diffuse floor under a rectangular light, seen from above at an angle;
+// a small sphere casts a shadow.
+scene lit_floor(bool projected) {
+  scene sc;
+  sc.materials = {lambertian{color(0.5f)}, diffuse_light{color(4.0f)}};
+  sc.add(xz_rect_shape{-50, 50, -50, 50, 0}, 0);
+  sc.add(sphere{{0.3f, 0.15f, 0.1f}, 0.15f}, 0);
+  const rect r = xz_rect(-0.6f, 0.6f, -0.4f, 0.4f, 0.8f, true);
+  if (projected)
+    sc.add_light(rect_projected_solid_angle_sampler{r}, 1);
+  else
+    sc.add_light(rect_area_sampler{r}, 1);
+  sc.ray_epsilon = 1e-4f;
+  return sc;
+}
+
+render_settings settings(int w, int h) {
+  render_settings rs;
+  rs.width = w;
+  rs.height = h;
+  rs.max_depth = 1;
+  rs.integrator = integrator_kind::nee;
+  rs.threads = 2;
+  return rs;
+}
+
+}  // namespace
+
+TEST(NoisePilot, StrideGivesAboutThePixelsAsked) {
+  EXPECT_EQ(noise_pilot_stride(100, 100, 1024), 3);
+  EXPECT_EQ(noise_pilot_stride(300, 300, 1024), 9);
+  EXPECT_EQ(noise_pilot_stride(16, 16, 1024), 1);
+  const camera cam({0, 1.5f, -2}, {0, 0, 0}, {0, 1, 0}, 50, 1.0f);
+  const noise_pilot_result r = estimate_image_variance(lit_floor(false), cam, settings(100, 100));
+  EXPECT_EQ(r.stride, 3);
+  EXPECT_EQ(r.pixels, 33 * 33);  // pixels 1, 4, ..., 97 in each direction
+}
+
+// A view with nothing random in it (one emitter filling the view, pixel
+// jitter included) has no variance; the
+// lit floor has some, and sampling its light by projected solid angle (no
+// variance of its own for an unoccluded diffuse receiver) leaves less.
+TEST(NoisePilot, ZeroWithoutNoiseAndLessWithABetterStrategy) {
+  scene flat;
+  flat.materials = {diffuse_light{color(2.0f)}};
+  flat.add(xy_rect_shape{-100, 100, -100, 100, 5, true}, 0);  // front side towards the camera
+  flat.ray_epsilon = 1e-4f;
+  const camera front({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 30, 1.0f);
+  render_settings rs = settings(40, 40);
+  rs.spp = 2;
+  EXPECT_EQ(render(flat, front, rs).img.at(20, 20), color(2.0f)) << "the emitter fills the view";
+  EXPECT_EQ(estimate_image_variance(flat, front, rs).image_variance, 0.0);
+
+  const camera cam({0, 1.5f, -2}, {0, 0, 0}, {0, 1, 0}, 50, 1.0f);
+  const double area = estimate_image_variance(lit_floor(false), cam, settings(64, 64)).image_variance;
+  const double psa = estimate_image_variance(lit_floor(true), cam, settings(64, 64)).image_variance;
+  EXPECT_GT(area, 0.0);
+  EXPECT_GT(psa, 0.0) << "the shadow's edge and the pixel footprints stay noisy";
+  EXPECT_LT(psa, 0.5 * area);
+}
+
+// Unbiased whatever the samples per pixel (see the header of this file).
+TEST(NoisePilot, UnbiasedForAnySamplesPerPixel) {
+  const scene sc = lit_floor(false);
+  const camera cam({0, 1.5f, -2}, {0, 0, 0}, {0, 1, 0}, 50, 1.0f);
+  render_settings rs = settings(24, 24);
+  noise_pilot_settings many{1024, 256};
+  rs.seed = 7;
+  const double reference = estimate_image_variance(sc, cam, rs, many).image_variance;
+  // The 256-sample value's own spread, from 8 seeds.
+  std::vector<double> refs;
+  for (std::uint64_t s = 100; s < 108; ++s) {
+    rs.seed = s;
+    refs.push_back(estimate_image_variance(sc, cam, rs, many).image_variance);
+  }
+  double rm = 0.0, rv = 0.0;
+  for (double v : refs) rm += v / refs.size();
+  for (double v : refs) rv += (v - rm) * (v - rm) / (refs.size() - 1);
+
+  const int n = 200;
+  double m = 0.0, v = 0.0;
+  std::vector<double> xs;
+  for (int i = 0; i < n; ++i) {
+    rs.seed = 1000 + i;
+    xs.push_back(estimate_image_variance(sc, cam, rs, {1024, 2}).image_variance);
+    m += xs.back() / n;
+  }
+  for (double x : xs) v += (x - m) * (x - m) / (n - 1);
+  const double se = std::sqrt(v / n + rv);
+  std::printf("2 spp: mean %g, sd %g; 256 spp: %g (mean of 8: %g, sd %g)\n", m, std::sqrt(v), reference, rm, std::sqrt(rv));
+  EXPECT_GT(reference, 0.0);
+  EXPECT_LE(std::abs(m - reference), 5.0 * se) << "2 spp: " << m << ", 256 spp: " << reference << ", se " << se;
+  EXPECT_LT(se, 0.1 * reference) << "the check must be sharp enough to mean something";
+}
+
+// The result does not depend on the thread count (rows are summed in order),
+// so neither do the choices of `auto`.
+TEST(NoisePilot, IdenticalForAnyThreadCount) {
+  const scene sc = lit_floor(false);
+  const camera cam({0, 1.5f, -2}, {0, 0, 0}, {0, 1, 0}, 50, 1.0f);
+  render_settings rs = settings(77, 53);
+  rs.threads = 1;
+  const double one = estimate_image_variance(sc, cam, rs).image_variance;
+  for (unsigned t : {2u, 3u, 8u}) {
+    rs.threads = t;
+    EXPECT_EQ(estimate_image_variance(sc, cam, rs).image_variance, one) << t << " threads";
+  }
+}
