@@ -8,6 +8,7 @@
 //  BM_RectPSA_Bilinear<normals> rect_bilinear_solid_angle_sampler
 //  BM_RectPSA_FloorPeters21<normals> Peters 2021 as published (see below)
 //  BM_RectPSA_FloorPeters21WithPdf<normals> the same, its pdf charged as a second call's
+//  BM_RectPSA_Peters21Exact[WithPdf]<normals> the same made exact: double, iterated to mcrt's tolerance
 //
 // Receiver normals: "Up", n = (0, 1, 0) for every observer (a floor under
 // the light: the light is wholly above every horizon, no clipping);
@@ -21,6 +22,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -128,296 +133,27 @@ BENCHMARK(BM_RectPSA_Bilinear<normals::random>)->Name("BM_RectPSA_Bilinear/Rando
 // fallback, Lambert's sum as is), so this bounds from below what the
 // published algorithm costs per sample plus pdf on these observers.
 namespace peters21 {
-
-constexpr int max_vertices = 5;
-constexpr float pi_f = 3.14159265358979f;
-
-inline float kahan(float a, float b, float c, float d) {
-  const float cd = c * d;
-  const float err = std::fma(c, d, -cd);
-  const float res = std::fma(a, b, -cd);
-  return res - err;
-}
-inline vec3 cross_stable(const vec3& l, const vec3& r) {
-  return {kahan(l.y, r.z, l.z, r.y), kahan(l.z, r.x, l.x, r.z), kahan(l.x, r.y, l.y, r.x)};
-}
-inline vec2 rotate_90(vec2 v) { return {-v.y, v.x}; }
-inline bool is_inner_ellipse(vec2 e) { return std::signbit(e.x); }
-inline float positive_atan(float t) { return std::atan(t) + (t < 0.0f ? pi_f : 0.0f); }
-inline float mix_fma(float x, float y, float a) { return std::fma(a, y, std::fma(-a, x, x)); }
-inline float inversesqrt(float x) { return 1.0f / std::sqrt(x); }
-
-inline vec2 ellipse_from_edge(const vec3& v0, const vec3& v1) {
-  const vec3 normal = cross_stable(v0, v1);
-  float scaling = 1.0f / normal.z;
-  scaling = is_inner_ellipse(vec2(normal)) ? -scaling : scaling;
-  vec2 e = vec2(normal) * scaling;
-  e.x = normal.z != 0.0f ? e.x : infinity;
-  return e;
-}
-inline vec2 ellipse_transform(vec2 e, vec2 p) { return glm::dot(e, p) * e + p; }
-inline float get_ellipse_det(vec2 e) { return std::fma(e.x, e.x, std::fma(e.y, e.y, 1.0f)); }
-inline float get_ellipse_rsqrt_det(vec2 e) { return inversesqrt(get_ellipse_det(e)); }
-inline float get_ellipse_direction_factor_rsq(vec2 e, vec2 d) {
-  const float ed = glm::dot(e, d);
-  return std::fma(ed, ed, glm::dot(d, d));
-}
-inline float get_ellipse_direction_factor(vec2 e, vec2 d) { return inversesqrt(get_ellipse_direction_factor_rsq(e, d)); }
-inline float get_ellipse_normalized_direction_factor(vec2 e, vec2 d) {
-  const float ed = glm::dot(e, d);
-  return inversesqrt(std::fma(ed, ed, 1.0f));
-}
-inline float area_between_from_tangents(float in_rsd, float in_tan, float out_rsd, float out_tan) {
-  const float inner = in_rsd * positive_atan(in_tan);
-  const float result = std::fma(out_rsd, positive_atan(out_tan), -inner);
-  return result > 0.0f ? 0.5f * result : 0.0f;
-}
-inline float area_between_in_sector(vec2 ie, float in_rsd, vec2 oe, float out_rsd, vec2 d0, vec2 d1) {
-  const float det = std::max(0.0f, glm::dot(d1, rotate_90(d0)));
-  const float in_dot = in_rsd * glm::dot(d0, ellipse_transform(ie, d1));
-  const float out_dot = out_rsd * glm::dot(d0, ellipse_transform(oe, d1));
-  return area_between_from_tangents(in_rsd, det / in_dot, out_rsd, det / out_dot);
-}
-inline float ellipse_area_in_sector(vec2 e, vec2 d0, vec2 d1) {
-  const float rsd = get_ellipse_rsqrt_det(e);
-  const float det = std::max(0.0f, glm::dot(d1, rotate_90(d0)));
-  const float edot = rsd * glm::dot(d0, ellipse_transform(e, d1));
-  const float area = 0.5f * rsd * positive_atan(det / edot);
-  return rsd > 0.0f ? area : 0.0f;
-}
-
-struct polygon {
-  int vertex_count = 0;
-  vec2 vertices[max_vertices];
-  vec2 ellipses[max_vertices];
-  vec2 inner_ellipse_0;
-  float sector_psa[max_vertices];
-  float psa = 0.0f;
-};
-
-inline void compare_and_swap(polygon& p, int l, int r) {
-  const vec2 lc = p.vertices[l];
-  const float nz = kahan(lc.x, -p.vertices[r].y, lc.y, -p.vertices[r].x);
-  const bool swap = nz == 0.0f ? std::isinf(p.ellipses[r].x) : nz > 0.0f;
-  if (swap) {
-    std::swap(p.vertices[l], p.vertices[r]);
-    std::swap(p.ellipses[l], p.ellipses[r]);
-  }
-}
-inline void sort_vertices(polygon& p) {
-  if (p.vertex_count == 3) {
-    compare_and_swap(p, 1, 2);
-  } else if (p.vertex_count == 4) {
-    compare_and_swap(p, 1, 3);
-  } else {
-    compare_and_swap(p, 2, 4);
-    compare_and_swap(p, 1, 3);
-    compare_and_swap(p, 1, 2);
-    compare_and_swap(p, 0, 3);
-    compare_and_swap(p, 3, 4);
-  }
-  compare_and_swap(p, 0, 2);
-  if (p.vertex_count >= 4) compare_and_swap(p, 2, 3);
-  compare_and_swap(p, 0, 1);
-}
-
-// vertices: clockwise as seen from the origin, the first repeated at
-// vertex_count when vertex_count < max_vertices.
-inline polygon prepare(int vertex_count, const vec3 (&v)[max_vertices]) {
-  polygon p;
-  p.vertex_count = vertex_count;
-  p.inner_ellipse_0 = {1.0f, 0.0f};
-  p.vertices[0] = vec2(v[0]);
-  p.ellipses[0] = ellipse_from_edge(v[0], v[1]);
-  vec2 previous = p.ellipses[0];
-  for (int i = 1; i != max_vertices; ++i) {
-    p.vertices[i] = vec2(v[i]);
-    if (i > 2 && i == vertex_count) break;
-    const vec2 e = ellipse_from_edge(v[i], v[(i + 1) % max_vertices]);
-    const bool inner = is_inner_ellipse(e);
-    p.ellipses[i] = inner ? previous : e;
-    p.inner_ellipse_0 = (is_inner_ellipse(previous) && !inner) ? previous : p.inner_ellipse_0;
-    previous = e;
-  }
-  const vec2 e = p.ellipses[0];
-  const bool inner = is_inner_ellipse(e);
-  p.ellipses[0] = inner ? previous : e;
-  p.inner_ellipse_0 = (is_inner_ellipse(previous) && !inner) ? previous : p.inner_ellipse_0;
-  p.psa = 0.0f;
-  if (p.inner_ellipse_0.x > 0.0f) {  // central case
-    for (int i = 0; i != max_vertices; ++i) {
-      if (i > 2 && i == p.vertex_count) break;
-      p.sector_psa[i] = ellipse_area_in_sector(p.ellipses[i], p.vertices[i], p.vertices[(i + 1) % max_vertices]);
-      p.psa += p.sector_psa[i];
-    }
-  } else {
-    sort_vertices(p);
-    vec2 ie = p.inner_ellipse_0, oe{};
-    float in_rsd = get_ellipse_rsqrt_det(ie), out_rsd = 0.0f;
-    for (int i = 0; i != max_vertices - 1; ++i) {
-      if (i > 1 && i + 1 == p.vertex_count) break;
-      const vec2 ve = p.ellipses[i];
-      const bool vi = is_inner_ellipse(ve);
-      const float vr = get_ellipse_rsqrt_det(ve);
-      if (i == 0) {
-        oe = ve;
-        out_rsd = vr;
-      } else {
-        ie = vi ? ve : ie;
-        in_rsd = vi ? vr : in_rsd;
-        oe = vi ? oe : ve;
-        out_rsd = vi ? out_rsd : vr;
-      }
-      p.sector_psa[i] = area_between_in_sector(ie, in_rsd, oe, out_rsd, p.vertices[i], p.vertices[i + 1]);
-      p.psa += p.sector_psa[i];
-    }
-  }
-  return p;
-}
-
-inline vec2 normalize_approx_and_flip(vec2 r, vec2 semi_circle) {
-  float scaling = 1.0f / (std::abs(r.x) + std::abs(r.y));
-  scaling = glm::dot(r, semi_circle) >= 0.0f ? scaling : -scaling;
-  return scaling * r;
-}
-// 2 x 2 matrix as columns m[col][row] (GLSL layout).
-struct mat2c {
-  float m[2][2];
-};
-inline mat2c outer(vec2 c, vec2 r) { return {{{c.x * r.x, c.y * r.x}, {c.x * r.y, c.y * r.y}}}; }
-inline vec2 solve_homogeneous_quadratic(const mat2c& q) {
-  const float coeff_xy = 0.5f * (q.m[0][1] + q.m[1][0]);
-  const float sqrt_disc = std::sqrt(std::max(0.0f, coeff_xy * coeff_xy - q.m[0][0] * q.m[1][1]));
-  const float scaled_root = std::abs(coeff_xy) + sqrt_disc;
-  return coeff_xy >= 0.0f ? vec2(scaled_root, -q.m[0][0]) : vec2(q.m[1][1], scaled_root);
-}
-
-inline vec2 sample_sector_between_ellipses(vec2 rn, float target_area, vec2 ie, vec2 oe, vec2 d0, vec2 d1,
-                                           int iteration_count) {
-  vec2 qd[3];
-  qd[0] = glm::normalize(d0);
-  qd[2] = glm::normalize(d1);
-  qd[1] = qd[0] + qd[2];
-  float nf[2][3] = {{get_ellipse_normalized_direction_factor(ie, qd[0]), get_ellipse_direction_factor(ie, qd[1]),
-                     get_ellipse_normalized_direction_factor(ie, qd[2])},
-                    {get_ellipse_normalized_direction_factor(oe, qd[0]), get_ellipse_direction_factor(oe, qd[1]),
-                     get_ellipse_normalized_direction_factor(oe, qd[2])}};
-  const float sector_areas[2] = {nf[1][0] * nf[1][1] - nf[0][0] * nf[0][1], nf[1][1] * nf[1][2] - nf[0][1] * nf[0][2]};
-  float tqa = mix_fma(-sector_areas[0], sector_areas[1], rn.x);
-  const bool first = tqa <= 0.0f;
-  qd[2] = first ? qd[0] : qd[2];
-  nf[0][2] = first ? nf[0][0] : nf[0][2];
-  nf[1][2] = first ? nf[1][0] : nf[1][2];
-  tqa += first ? sector_areas[0] : -sector_areas[1];
-  tqa *= std::abs(qd[1].x * qd[2].y - qd[2].x * qd[1].y);
-  vec2 qn[2] = {qd[1] * nf[0][1] + qd[2] * nf[0][2], qd[1] * nf[1][1] + qd[2] * nf[1][2]};
-  qn[0] = ellipse_transform(ie, qn[0]);
-  qn[1] = ellipse_transform(oe, qn[1]);
-  const float qo[2] = {glm::dot(qn[0], qd[1]) * nf[0][1], glm::dot(qn[1], qd[1]) * nf[1][1]};
-  mat2c q = outer((qo[1] * nf[1][2]) * rotate_90(qd[2]), qn[0]);
-  const mat2c q2 = outer((qo[0] * nf[0][2]) * rotate_90(qd[2]) + tqa * qn[0], qn[1]);
-  for (int c = 0; c < 2; ++c)
-    for (int r = 0; r < 2; ++r) q.m[c][r] -= q2.m[c][r];
-  vec2 dir = solve_homogeneous_quadratic(q);
-  const float acceptable_error = 1.0e-5f;
-  iteration_count = std::abs(rn.x - 0.5f) <= 0.5f - acceptable_error ? iteration_count : 0;
-  const float in_rsd = get_ellipse_rsqrt_det(ie), out_rsd = get_ellipse_rsqrt_det(oe);
-  for (int i = 0; i != iteration_count; ++i) {
-    dir = normalize_approx_and_flip(dir, qd[1]);
-    const vec2 idir = ellipse_transform(ie, dir), odir = ellipse_transform(oe, dir);
-    const float det = std::max(0.0f, glm::dot(dir, rotate_90(qd[0])));
-    const float error = target_area - area_between_from_tangents(in_rsd, det / (in_rsd * glm::dot(qd[0], idir)), out_rsd,
-                                                                 det / (out_rsd * glm::dot(qd[0], odir)));
-    mat2c a = outer(idir - odir, rotate_90(dir));
-    const mat2c b = outer((2.0f * error) * idir, odir);
-    for (int c = 0; c < 2; ++c)
-      for (int r = 0; r < 2; ++r) a.m[c][r] -= b.m[c][r];
-    dir = solve_homogeneous_quadratic(a);
-  }
-  dir = glm::dot(dir, qd[1]) >= 0.0f ? dir : -dir;
-  const float inner_factor = 1.0f / get_ellipse_direction_factor_rsq(ie, dir);
-  const float outer_factor = 1.0f / get_ellipse_direction_factor_rsq(oe, dir);
-  return dir * std::sqrt(mix_fma(inner_factor, outer_factor, rn.y));
-}
-
-inline vec3 sample(const polygon& p, vec2 rn) {
-  float target = rn.x * p.psa;
-  vec3 out;
-  vec2 oe{}, d0{};
-  if (p.inner_ellipse_0.x > 0.0f) {
-    for (int i = 0; i != max_vertices; ++i) {
-      if (i > 0) target -= p.sector_psa[i - 1];
-      oe = p.ellipses[i];
-      d0 = p.vertices[i];
-      if ((i >= 2 && i + 1 == p.vertex_count) || target < p.sector_psa[i]) break;
-    }
-    const float sqrt_det = std::sqrt(get_ellipse_det(oe));
-    const float angle = 2.0f * target * sqrt_det;
-    vec2 xy = (std::cos(angle) * sqrt_det) * d0 + std::sin(angle) * rotate_90(ellipse_transform(oe, d0));
-    xy *= std::sqrt(rn.y / get_ellipse_direction_factor_rsq(oe, xy));
-    out = {xy, 0.0f};
-  } else {
-    float sector = 0.0f;
-    vec2 ie = p.inner_ellipse_0, d1{};
-    for (int i = 0; i != max_vertices - 1; ++i) {
-      const vec2 ve = p.ellipses[i];
-      if (i == 0) {
-        oe = ve;
-      } else {
-        target -= p.sector_psa[i - 1];
-        const bool vi = is_inner_ellipse(ve);
-        ie = vi ? ve : ie;
-        oe = vi ? oe : ve;
-      }
-      d0 = p.vertices[i];
-      d1 = p.vertices[i + 1];
-      sector = p.sector_psa[i];
-      if ((i >= 1 && i + 2 == p.vertex_count) || target < sector) break;
-    }
-    rn.x = target / sector;
-    out = {sample_sector_between_ellipses(rn, target, ie, oe, d0, d1, 2), 0.0f};
-  }
-  out.z = std::sqrt(std::max(0.0f, std::fma(-out.x, out.x, std::fma(-out.y, out.y, 1.0f))));
-  return out;
-}
-
-// The rectangle's corners in the receiver's frame (Duff et al. 2017 basis),
-// clockwise as seen from o, clipped at z = 0 (Sutherland-Hodgman, as
-// polygon_clipping.glsl's table does case by case); the first vertex
-// repeated at the count. Returns the count (0: nothing above the horizon).
-struct frame {
-  vec3 t, b, n;
-  explicit frame(const vec3& nn) : n(nn) {
-    const float sign = std::copysign(1.0f, n.z);
-    const float a = -1.0f / (sign + n.z), bb = n.x * n.y * a;
-    t = {1.0f + sign * n.x * n.x * a, sign * bb, -sign * n.x};
-    b = {bb, sign + n.y * n.y * a, -n.y};
-  }
-  vec3 to_local(const vec3& v) const { return {glm::dot(v, t), glm::dot(v, b), glm::dot(v, n)}; }
-  vec3 to_world(const vec3& v) const { return v.x * t + v.y * b + v.z * n; }
-};
-inline int clip(const rect& r, const vec3& o, const frame& f, vec3 (&v)[max_vertices]) {
-  vec3 c[4] = {f.to_local(r.corner - o), f.to_local(r.corner + r.e1 - o), f.to_local(r.corner + r.e1 + r.e2 - o),
-               f.to_local(r.corner + r.e2 - o)};
-  // Clockwise as seen from the origin (counterclockwise about the zenith
-  // for a polygon above): the triple product of the first three corners is
-  // positive; reverse the order otherwise.
-  if (glm::dot(c[0], glm::cross(c[1], c[2])) < 0.0f) std::swap(c[1], c[3]);
-  int k = 0;
-  for (int i = 0; i < 4; ++i) {
-    const vec3 &a = c[i], &b = c[(i + 1) & 3];
-    if (a.z > 0.0f) v[k++] = a;
-    if ((a.z > 0.0f) != (b.z > 0.0f)) {
-      const float s = a.z / (a.z - b.z);
-      v[k++] = vec3(vec2(a) + s * (vec2(b) - vec2(a)), 0.0f);
-    }
-  }
-  if (k < 3) return 0;
-  if (k < max_vertices) v[k] = v[0];
-  return k;
-}
-
+using real = float;
+using rvec2 = glm::vec2;
+using rvec3 = glm::vec3;
+constexpr int iterations = 2;           // the published default
+constexpr real relative_tolerance = 0;  // no early stop: the fixed count
+#include "peters21_port.inc"
 }  // namespace peters21
+
+// The same algorithm made exact the way mcrt's sampler is: double
+// throughout, and the solver iterated until the residual area is at most
+// 1e-12 of the projected solid angle (projected_polygon.hpp's
+// newton_tolerance), at most 16 iterations. What Peters' method costs when
+// it is asked for what mcrt's exact sampler delivers.
+namespace peters21_exact {
+using real = double;
+using rvec2 = glm::dvec2;
+using rvec3 = glm::dvec3;
+constexpr int iterations = 16;
+constexpr real relative_tolerance = 1e-12;
+#include "peters21_port.inc"
+}  // namespace peters21_exact
 
 // sample + pdf of Peters 2021 as published (see above) on the observers.
 // With charge_pdf (BM_RectPSA_FloorPeters21WithPdf) the pdf of the sampled
@@ -426,40 +162,108 @@ inline int clip(const rect& r, const vec3& o, const frame& f, vec3 (&v)[max_vert
 // projected solid angle), then cos / Omega_proj. Not the published usage (a
 // shader prepares once per shading point and reuses the set-up for the light
 // sample and the BSDF direction's pdf), but the like-for-like counterpart of
-// sample() + pdf() through a stateless interface.
-template <normals N, bool charge_pdf>
+// sample() + pdf() through a stateless interface. Api: peters21::api (as
+// published) or peters21_exact::api (double, iterated to mcrt's tolerance);
+// the counter "evals" is the solver's area evaluations per sample.
+// Self-check of the exact port before its first benchmark: on every 16th
+// observer, both normal sets, 16 samples each, its projected solid angle
+// against mcrt's exact one (cos / pdf of mcrt's sampler, 1e-5 relative: the
+// float pdf), each sample's direction unit, above the horizon and through
+// the light, and no solver out of iterations. Empty if all holds.
+std::string peters21_exact_self_check() {
+  const rect light = bench::cornell_rect_light();
+  const std::vector<vec3> obs = bench::observers_around(light);
+  const rect_projected_solid_angle_sampler mcrt_psa{light};
+  pcg32 rng(7, 9);
+  peters21_exact::unconverged = 0;
+  double worst = 0.0;
+  for (const normals kind : {normals::up, normals::random}) {
+    const std::vector<vec3> ns = receiver_normals(light, obs, kind);
+    for (std::size_t k = 0; k < obs.size(); k += 16) {
+      const peters21_exact::frame f{glm::dvec3(ns[k])};
+      glm::dvec3 v[peters21_exact::max_vertices];
+      const int count = peters21_exact::clip(light, glm::dvec3(obs[k]), f, v);
+      if (count == 0) continue;
+      const peters21_exact::polygon p = peters21_exact::prepare(count, v);
+      for (int j = 0; j < 16; ++j) {
+        const glm::dvec3 dir = f.to_world(peters21_exact::sample(p, glm::dvec2(rng.uniform2())));
+        const vec3 d(dir);
+        const double cz = glm::dot(dir, glm::dvec3(ns[k]));
+        const float pdf = mcrt_psa.pdf(obs[k], ns[k], d);
+        hit_record rec;
+        const bool hits = light.hit(ray{obs[k], d}, 1e-4f, infinity, rec);
+        if (!(std::abs(glm::length(dir) - 1.0) <= 1e-9) || !(cz >= -1e-9) || !hits || !(pdf > 0.0f)) {
+          char msg[200];
+          std::snprintf(msg, sizeof msg, "Peters 2021 exact port, observer %zu: |dir| %.12f, cos %.3g, hits %d, pdf %g", k,
+                        glm::length(dir), cz, int(hits), double(pdf));
+          return msg;
+        }
+        const double rel = std::abs(p.psa - cz / pdf) / p.psa;
+        worst = std::max(worst, rel);
+        if (!(rel <= 1e-5)) {
+          char msg[200];
+          std::snprintf(msg, sizeof msg, "Peters 2021 exact port, observer %zu: Omega_proj %.9g, mcrt's %.9g", k, p.psa,
+                        cz / pdf);
+          return msg;
+        }
+      }
+    }
+  }
+  if (peters21_exact::unconverged) return "Peters 2021 exact port: a solver ran out of iterations";
+  std::fprintf(stderr, "Peters 2021 exact port self-check passed: Omega_proj within %.2g of mcrt's\n", worst);
+  return {};
+}
+
+template <class Api, normals N, bool charge_pdf>
 void BM_RectPSA_FloorPeters21(benchmark::State& state) {
+  if constexpr (std::is_same_v<Api, peters21_exact::api>) {
+    static const std::string error = peters21_exact_self_check();
+    if (!error.empty()) {
+      state.SkipWithError(error.c_str());
+      return;
+    }
+  }
+  using V3 = typename Api::vec3_type;
+  using V2 = typename Api::vec2_type;
   const rect light = bench::cornell_rect_light();
   const std::vector<vec3> obs = bench::observers_around(light);
   const std::vector<vec3> ns = receiver_normals(light, obs, N);
   pcg32 rng(1, 2);
   std::size_t i = 0;
+  long long samples = 0;
+  Api::evaluations() = 0;
   for (auto _ : state) {
     const std::size_t k = i++ & (obs.size() - 1);
-    const peters21::frame f(ns[k]);
-    vec3 v[peters21::max_vertices];
-    const int count = peters21::clip(light, obs[k], f, v);
+    const typename Api::frame_type f{V3(ns[k])};
+    V3 v[Api::vertices];
+    const int count = Api::clip_rect(light, V3(obs[k]), f, v);
     if (count == 0) continue;
-    const peters21::polygon p = peters21::prepare(count, v);
-    const vec3 local = peters21::sample(p, rng.uniform2());
-    const vec3 dir = f.to_world(local);
+    const typename Api::polygon_type p = Api::prepare_polygon(count, v);
+    const V3 local = Api::sample_polygon(p, V2(rng.uniform2()));
+    const V3 dir = f.to_world(local);
+    ++samples;
     benchmark::DoNotOptimize(dir);
     if constexpr (charge_pdf) {
-      const peters21::frame f2(ns[k]);
-      vec3 v2[peters21::max_vertices];
-      const int count2 = peters21::clip(light, obs[k], f2, v2);
+      const typename Api::frame_type f2{V3(ns[k])};
+      V3 v2[Api::vertices];
+      const int count2 = Api::clip_rect(light, V3(obs[k]), f2, v2);
       if (count2 == 0) continue;
-      const peters21::polygon p2 = peters21::prepare(count2, v2);
-      benchmark::DoNotOptimize(glm::dot(dir, ns[k]) / p2.psa);
+      const typename Api::polygon_type p2 = Api::prepare_polygon(count2, v2);
+      benchmark::DoNotOptimize(glm::dot(dir, V3(ns[k])) / p2.psa);
     } else {
       benchmark::DoNotOptimize(local.z / p.psa);
     }
   }
   state.SetItemsProcessed(state.iterations());
+  state.counters["evals"] = samples ? double(Api::evaluations()) / double(samples) : 0.0;
 }
-BENCHMARK(BM_RectPSA_FloorPeters21<normals::up, false>)->Name("BM_RectPSA_FloorPeters21/Up");
-BENCHMARK(BM_RectPSA_FloorPeters21<normals::random, false>)->Name("BM_RectPSA_FloorPeters21/Random");
-BENCHMARK(BM_RectPSA_FloorPeters21<normals::up, true>)->Name("BM_RectPSA_FloorPeters21WithPdf/Up");
-BENCHMARK(BM_RectPSA_FloorPeters21<normals::random, true>)->Name("BM_RectPSA_FloorPeters21WithPdf/Random");
+BENCHMARK(BM_RectPSA_FloorPeters21<peters21::api, normals::up, false>)->Name("BM_RectPSA_FloorPeters21/Up");
+BENCHMARK(BM_RectPSA_FloorPeters21<peters21::api, normals::random, false>)->Name("BM_RectPSA_FloorPeters21/Random");
+BENCHMARK(BM_RectPSA_FloorPeters21<peters21::api, normals::up, true>)->Name("BM_RectPSA_FloorPeters21WithPdf/Up");
+BENCHMARK(BM_RectPSA_FloorPeters21<peters21::api, normals::random, true>)->Name("BM_RectPSA_FloorPeters21WithPdf/Random");
+BENCHMARK(BM_RectPSA_FloorPeters21<peters21_exact::api, normals::up, false>)->Name("BM_RectPSA_Peters21Exact/Up");
+BENCHMARK(BM_RectPSA_FloorPeters21<peters21_exact::api, normals::random, false>)->Name("BM_RectPSA_Peters21Exact/Random");
+BENCHMARK(BM_RectPSA_FloorPeters21<peters21_exact::api, normals::up, true>)->Name("BM_RectPSA_Peters21ExactWithPdf/Up");
+BENCHMARK(BM_RectPSA_FloorPeters21<peters21_exact::api, normals::random, true>)->Name("BM_RectPSA_Peters21ExactWithPdf/Random");
 
 }  // namespace

@@ -116,6 +116,7 @@ int run_render(const render_options& opt) {
     noise = estimate_image_variance(ls.world, cam, rs);
     // A noise-free pilot leaves nothing for a cheaper strategy to hide in.
     ap.image_variance = std::max(static_cast<float>(noise->image_variance), std::numeric_limits<float>::min());
+    ap.albedo = static_cast<float>(std::sqrt(noise->mean_albedo2));
     ls = load_scene(opt.scene, strategy, map, ap);
   }
 
@@ -158,6 +159,7 @@ int run_render(const render_options& opt) {
     if (noise) {
       j["auto_pilot_seconds"] = noise->seconds;
       j["auto_image_variance"] = noise->image_variance;
+      j["auto_albedo"] = std::sqrt(noise->mean_albedo2);
     }
     write_text(opt.stats, j.dump(2) + "\n");
   }

@@ -337,6 +337,8 @@ TEST_F(Cli, AutoNoisePilotInStats) {
   auto j = nlohmann::json::parse(slurp(stats));
   ASSERT_TRUE(j.contains("auto_pilot_seconds"));
   ASSERT_TRUE(j.contains("auto_image_variance"));
+  ASSERT_TRUE(j.contains("auto_albedo"));
+  EXPECT_NEAR(j["auto_albedo"].get<double>(), 0.7, 1e-6);  // scene_with's white floor
   EXPECT_GT(j["auto_image_variance"].get<double>(), 0.0);
   EXPECT_LE(j["auto_pilot_seconds"].get<double>(), j["render_seconds"].get<double>());
   for (const char* flags : {"--light-sampling auto --auto-rest-variance 4", "--light-sampling area", ""}) {

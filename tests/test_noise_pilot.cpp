@@ -47,7 +47,7 @@ render_settings settings(int w, int h) {
 
 }  // namespace
 
-TEST(NoisePilot, StrideGivesAboutThePixelsAsked) {
+TEST(NoisePilot, StrideGivesAboutThePixelsAskedAndTheAlbedoSeen) {
   EXPECT_EQ(noise_pilot_stride(100, 100, 1024), 3);
   EXPECT_EQ(noise_pilot_stride(300, 300, 1024), 9);
   EXPECT_EQ(noise_pilot_stride(16, 16, 1024), 1);
@@ -55,6 +55,8 @@ TEST(NoisePilot, StrideGivesAboutThePixelsAsked) {
   const noise_pilot_result r = estimate_image_variance(lit_floor(false), cam, settings(100, 100));
   EXPECT_EQ(r.stride, 3);
   EXPECT_EQ(r.pixels, 33 * 33);  // pixels 1, 4, ..., 97 in each direction
+  // Every diffuse surface seen has albedo 0.5 (the light is not diffuse).
+  EXPECT_DOUBLE_EQ(r.mean_albedo2, 0.25);
 }
 
 // A view with nothing random in it (one emitter filling the view, pixel

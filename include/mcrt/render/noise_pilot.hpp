@@ -11,13 +11,17 @@
 // and its variance is the unbiased sample variance of those. The mean over
 // the pixels is then an unbiased estimate of the image's mean variance per
 // sample with independent samples (quasi-random samples converge faster
-// where the integrand is smooth; the pilot does not model that).
+// where the integrand is smooth; the pilot does not model that). It also
+// takes the mean squared albedo of the diffuse surfaces the pixels' centres
+// see (the channels' mean): the light's contribution to a pixel is the
+// surface's albedo times a white surface's, which `auto` takes on average.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <thread>
+#include <variant>
 #include <vector>
 
 #include "mcrt/render/camera.hpp"
@@ -33,6 +37,7 @@ struct noise_pilot_settings {
 
 struct noise_pilot_result {
   double image_variance = 0.0;  // mean variance of one pixel sample, radiance^2
+  double mean_albedo2 = 1.0;    // mean squared albedo (of the channels' mean) the camera sees on diffuse surfaces
   double seconds = 0.0;         // wall-clock time of the pilot
   int pixels = 0;               // pixels measured
   int stride = 1;
@@ -63,16 +68,25 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
   // Per row, summed in row order afterwards: the result does not depend on
   // which thread took which row (the choices of `auto` depend on it).
   std::atomic<int> next_row{0};
-  std::vector<double> row_sums(static_cast<std::size_t>(ny), 0.0);
-  std::vector<int> row_counts(static_cast<std::size_t>(ny), 0);
+  std::vector<double> row_sums(static_cast<std::size_t>(ny), 0.0), row_albedo2(static_cast<std::size_t>(ny), 0.0);
+  std::vector<int> row_counts(static_cast<std::size_t>(ny), 0), row_diffuse(static_cast<std::size_t>(ny), 0);
   auto worker = [&] {
     std::vector<glm::dvec3> c(static_cast<std::size_t>(m));
     for (int j; (j = next_row.fetch_add(1, std::memory_order_relaxed)) < ny;) {
       const int y = y0 + j * k;
-      double sum = 0.0;
-      int count = 0;
+      double sum = 0.0, albedo2 = 0.0;
+      int count = 0, diffuse = 0;
       for (int i = 0; i < nx; ++i) {
         const int x = x0 + i * k;
+        // The surface at the pixel's centre: its albedo, if diffuse.
+        hit_record rec;
+        if (sc.hit(cam.generate((static_cast<float>(x) + 0.5f) * inv_w, (static_cast<float>(y) + 0.5f) * inv_h),
+                   sc.ray_epsilon, infinity, rec))
+          if (const auto* l = std::get_if<lambertian>(&sc.materials[rec.material])) {
+            const double a = (double(l->albedo.r) + l->albedo.g + l->albedo.b) / 3.0;
+            albedo2 += a * a;
+            ++diffuse;
+          }
         auto px = sampler.start_pixel(x, y, rs.width);
         int finite = 0;
         glm::dvec3 mean(0.0);
@@ -94,6 +108,8 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
       }
       row_sums[static_cast<std::size_t>(j)] = sum;
       row_counts[static_cast<std::size_t>(j)] = count;
+      row_albedo2[static_cast<std::size_t>(j)] = albedo2;
+      row_diffuse[static_cast<std::size_t>(j)] = diffuse;
     }
   };
 
@@ -104,9 +120,14 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
     worker();
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  double sum = 0.0;
-  for (int j = 0; j < ny; ++j) sum += row_sums[static_cast<std::size_t>(j)], out.pixels += row_counts[static_cast<std::size_t>(j)];
+  double sum = 0.0, albedo2 = 0.0;
+  int diffuse = 0;
+  for (std::size_t j = 0; j < static_cast<std::size_t>(ny); ++j) {
+    sum += row_sums[j], out.pixels += row_counts[j];
+    albedo2 += row_albedo2[j], diffuse += row_diffuse[j];
+  }
   out.image_variance = out.pixels ? sum / out.pixels : 0.0;
+  if (diffuse > 0) out.mean_albedo2 = albedo2 / diffuse;
   return out;
 }
 

@@ -14,7 +14,9 @@
 // of the unoccluded light of constant radiance on a diffuse receiver at the
 // point, and v_rest the relative variance everything else adds (visibility,
 // the pixel's footprint, the indirect light). The strategy with the
-// smallest product is taken (efficiency = 1 / (error x time)). v_s from the
+// smallest product is taken (efficiency = 1 / (error x time)); where v_rest
+// comes from the image's measured noise (auto_params), the first-order form
+// of the image's own product, cost_s / t + v_s / v_rest. v_s from the
 // geometry at four points of the light, a rule exact for cubic (rectangle)
 // or quadratic (disk) variation over the light's surface:
 //  * area: the estimate is L A g, g = cos+(theta) cos(theta_l) / r^2, so
@@ -30,10 +32,11 @@
 // costs from the README's cost tables, c_rest from the error-against-time
 // study (cornell_rect, nee, sobol: ms per spp of area and solid-angle
 // sampling, 318 and 451 ns per path at 1.13 light samples per path, leave
-// 265 ns per light sample for the rest), v_rest = 4 the value, of those
-// tried (0.25, 1, 4, 16), with the best worst case over the study's scenes
-// (README, "Choosing per shading point", which also says how far this rule
-// is from the best fixed strategy).
+// 265 ns per light sample for the rest); a fixed v_rest = 4 is the value,
+// of those tried (0.25, 1, 4, 16), with the best worst case over the seed's
+// scenes, and `mcrt render` measures the image's noise instead (README,
+// "Choosing per shading point", which also says how far this rule is from
+// the best fixed strategy).
 //
 // Where a receiver is close to a planar light (within a fraction of its
 // size) g peaks near the light's nearest point and no fixed quadrature
@@ -70,24 +73,27 @@ namespace mcrt {
 // render --auto-rest-cost --auto-rest-variance` sets them).
 //
 // v_rest either is one number for every point (rest_variance), or follows
-// from the image's noise (image_variance > 0): the image's error is
-// minimised for its time where each light sample takes the strategy with
-// the least t_s / t + D^2 v_s / V (first order in the change of the
-// product error x time; t the time per light sample, D the light's
-// contribution to the pixel, V the image's mean variance per sample and
-// pixel), which is the product rule with v_rest = V / D^2 at the point.
-// D is taken as a white diffuse receiver's radiance, L Omega_proj / pi,
-// with L the light's radiance (radiance) and Omega_proj its projected
-// solid angle at the point: close to a bright light, where its own noise
+// from the image's noise (image_variance > 0): the image's error x time is
+// least where each light sample takes the strategy with the least
+// t_s / t + D^2 v_s / V (first order in one point's change of the product
+// of the image's error and time; t the time per light sample, D the
+// light's contribution to the pixel, V the image's mean variance per pixel
+// sample), i.e. t_s / t + v_s / v_rest with v_rest = V / D^2 at the point
+// (auto_choice::score).
+// D is taken as a diffuse receiver's radiance, rho L Omega_proj / pi, with
+// L the light's radiance, rho the receivers' albedo and Omega_proj the
+// light's projected solid angle at the point: close to a bright light, where its own noise
 // would dominate the pixel, v_rest is small and the dearer strategies
 // pay; where the image's noise is elsewhere (the edges of a light seen by
 // the camera, shadows, indirect light), v_rest is large and area sampling
-// is kept. `mcrt render` measures V by a pilot (render/noise_pilot.hpp).
+// is kept. `mcrt render` measures V, and rho as the root mean square of the
+// albedos the camera sees, by a pilot (render/noise_pilot.hpp).
 struct auto_params {
   float rest_cost = 265.0f;      // c_rest, ns per light sample
   float rest_variance = 4.0f;    // v_rest, where image_variance is 0
   float image_variance = 0.0f;   // V: mean variance of a pixel sample (radiance^2); 0: use rest_variance
   float radiance = 1.0f;         // L: the light's radiance (mean of its channels)
+  float albedo = 1.0f;           // rho: the receivers' albedo (root mean square)
 
   // v_rest at a point where the light's projected solid angle is omega_proj
   // (infinite where the light gives nothing: no strategy helps there; also
@@ -95,9 +101,10 @@ struct auto_params {
   // would overflow and every strategy's v is negligible anyway).
   float rest_variance_at(float omega_proj) const {
     if (!(image_variance > 0.0f)) return rest_variance;
-    const float d = radiance * omega_proj * inv_pi;
+    const float d = albedo * radiance * omega_proj * inv_pi;
     const float v = image_variance / (d * d);
-    return v < 1e30f ? v : std::numeric_limits<float>::infinity();
+    if (!(v < 1e30f)) return std::numeric_limits<float>::infinity();
+    return std::max(v, std::numeric_limits<float>::min());  // > 0: the rule divides by it
   }
 };
 
@@ -180,8 +187,22 @@ class auto_choice {
   // even at no variance of their own, v_rest being vr.
   static bool area_wins(float v_area, float vr, const auto_costs::shape_costs& c, const auto_params& p) {
     if (vr == std::numeric_limits<float>::infinity()) return cheapest(c) == light_sampling::area;
-    const float area = (c.area + p.rest_cost) * (v_area + vr);
-    return area <= (c.solid_angle + p.rest_cost) * vr && area <= (c.projected_solid_angle + p.rest_cost) * vr;
+    const float area = score(c.area, v_area, vr, c, p);
+    return area <= score(c.solid_angle, 0.0f, vr, c, p) && area <= score(c.projected_solid_angle, 0.0f, vr, c, p);
+  }
+
+  // The modelled error x time of a strategy of cost `cost` and variance v
+  // where v_rest is vr (smaller is better; only comparisons matter).
+  //  * v_rest fixed: the local product (cost + c_rest)(v + vr);
+  //  * v_rest from the image's noise (auto_params): the image's, to first
+  //    order in one point's change: cost / t + v / vr, t the time per light
+  //    sample, taken as c_rest plus the shape's cheapest strategy's cost.
+  //    (The local product would add a cross term cost v / (c_rest vr) that
+  //    wrongly favours the dearest, variance-free strategy where vr is small.)
+  static float score(float cost, float v, float vr, const auto_costs::shape_costs& c, const auto_params& p) {
+    if (p.image_variance > 0.0f)
+      return cost / (p.rest_cost + std::min({c.area, c.solid_angle, c.projected_solid_angle})) + v / vr;
+    return (cost + p.rest_cost) * (v + vr);
   }
 
   // The cheapest strategy: the choice where v_rest is infinite (the light
@@ -191,15 +212,15 @@ class auto_choice {
     return c.solid_angle <= c.projected_solid_angle ? light_sampling::solid_angle : light_sampling::projected_solid_angle;
   }
 
-  // The strategy with the least modelled (cost + c_rest)(variance + v_rest);
-  // the cheapest where no quadrature point is lit (nothing to gain).
+  // The strategy with the least modelled error x time (score); the cheapest
+  // where no quadrature point is lit (nothing to gain).
   light_sampling choose(const auto_costs::shape_costs& c, const auto_params& p = {}) const {
     if (!(sg_ > 0.0f)) return cheapest(c);
-    const float cr = p.rest_cost, vr = rest_variance(p);
+    const float vr = rest_variance(p);
     if (vr == std::numeric_limits<float>::infinity()) return cheapest(c);
-    const float area = (c.area + cr) * (v_area() + vr);
-    const float sa = (c.solid_angle + cr) * (v_solid_angle() + vr);
-    const float psa = (c.projected_solid_angle + cr) * vr;
+    const float area = score(c.area, v_area(), vr, c, p);
+    const float sa = score(c.solid_angle, v_solid_angle(), vr, c, p);
+    const float psa = score(c.projected_solid_angle, 0.0f, vr, c, p);
     if (area <= sa && area <= psa) return light_sampling::area;
     return sa <= psa ? light_sampling::solid_angle : light_sampling::projected_solid_angle;
   }
@@ -480,7 +501,8 @@ inline light_sampling choose_strategy(const sphere& s, const vec3& o, const vec3
     // Omega_proj = pi sin^2(alpha) cos(theta_c) for a cap above the horizon.
     const float vr = p.rest_variance_at(pi * r2 / d2 * h / std::sqrt(d2));
     if (vr == std::numeric_limits<float>::infinity() ||
-        (c.solid_angle + p.rest_cost) * (2.0f * v_sa + vr) <= (c.projected_solid_angle + p.rest_cost) * vr)
+        auto_choice::score(c.solid_angle, 2.0f * v_sa, vr, c, p) <=
+            auto_choice::score(c.projected_solid_angle, 0.0f, vr, c, p))
       return light_sampling::solid_angle;
   }
   return auto_model(s, o, n).choose(c, p);
