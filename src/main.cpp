@@ -113,7 +113,7 @@ int run_render(const render_options& opt) {
 
   std::optional<noise_pilot_result> noise;
   if (pilot && ls.auto_lights > 0) {
-    noise = estimate_image_variance(ls.world, cam, rs);
+    noise = estimate_image_variance(ls.world, cam, rs, noise_pilot_for(rs.width, rs.height, rs.spp));
     // A noise-free pilot leaves nothing for a cheaper strategy to hide in.
     ap.image_variance = std::max(static_cast<float>(noise->image_variance), std::numeric_limits<float>::min());
     ap.albedo = static_cast<float>(std::sqrt(noise->mean_albedo2));
@@ -224,7 +224,7 @@ int main(int argc, char** argv) {
                          "--light-sampling auto: the rest of the path's time per light sample, ns (default 265)");
   render_cmd->add_option("--auto-rest-variance", ro.auto_rest_variance,
                          "--light-sampling auto: the relative variance the rest of the path adds, one value everywhere "
-                         "(default: from the image's noise, measured by a pilot of about 1024 pixels x 2 samples)");
+                         "(default: from the image's noise, measured by a pilot of up to 1024 pixels x 2 samples)");
   render_cmd->add_option("--ellipse-map", ro.ellipse_map,
                          "Map of the spherical ellipse for ellipses sampled by solid angle (default parallel)")
       ->check(CLI::IsMember({"parallel", "polar"}));

@@ -387,6 +387,24 @@ TEST(AutoTable, ReproducesARuleAlignedWithItsCells) {
     ++checked;
   }
   EXPECT_GT(checked, 19000);
+  EXPECT_FALSE(table.uniform());
+}
+
+// A table whose cells all hold one choice says so, and answers it in front
+// of the light without a cell (area behind it, as every table).
+TEST(AutoTable, UniformTableAnswersItsOneChoice) {
+  const rect r = xz_rect(-1.0f, 1.0f, -0.5f, 0.5f, 0.0f, true);  // facing -y
+  const planar_auto_table table(vec3(0.0f), 0.5f * r.e1, 0.5f * r.e2, r.n,
+                                [](const vec3&, const vec3&) { return light_sampling::solid_angle; });
+  EXPECT_TRUE(table.uniform());
+  EXPECT_EQ(table.lookup(vec3(0.3f, -2.0f, 0.1f), vec3(0, 1, 0)), light_sampling::solid_angle);
+  EXPECT_EQ(table.lookup(vec3(0.3f, 2.0f, 0.1f), vec3(0, 1, 0)), light_sampling::area);
+  // A far small light in an image with any noise: every cell area.
+  auto_params p;
+  p.image_variance = 1.0f;
+  const rect tiny = xz_rect(-1e-3f, 1e-3f, -1e-3f, 1e-3f, 0.0f, true);
+  const rect_auto_sampler far_light(tiny, p);
+  EXPECT_EQ(far_light.choice(vec3(0.0f, -1.0f, 0.0f), vec3(0, 1, 0)), light_sampling::area);
 }
 
 // The tabulated rule against the rule itself at random receivers around a

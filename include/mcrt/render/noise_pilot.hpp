@@ -35,6 +35,14 @@ struct noise_pilot_settings {
   int spp = 2;        // samples per pixel (>= 2: a sample variance needs two)
 };
 
+// The pilot `mcrt render` runs for an image of width x height at spp: 1024
+// pixels, or fewer where that would exceed 1 % of the image's samples (at
+// least 64), with 2 samples each.
+inline noise_pilot_settings noise_pilot_for(int width, int height, int spp) {
+  const double budget = 0.01 * static_cast<double>(width) * height * spp / 2.0;  // pixels at 2 samples
+  return {static_cast<int>(std::clamp(budget, 64.0, 1024.0)), 2};
+}
+
 struct noise_pilot_result {
   double image_variance = 0.0;  // mean variance of one pixel sample, radiance^2
   double mean_albedo2 = 1.0;    // mean squared albedo (of the channels' mean) the camera sees on diffuse surfaces

@@ -73,7 +73,16 @@ class planar_auto_table {
             }
         }
     cells_ = std::move(cells);
+    // One choice in every cell (a light far from everything the image
+    // holds, or an image whose noise is all elsewhere): no lookup needed.
+    const std::uint8_t first = (*cells_)[0];
+    uniform_ = std::all_of(cells_->begin(), cells_->end(), [&](std::uint8_t c) { return c == first; });
+    uniform_choice_ = static_cast<light_sampling>(first);
   }
+
+  // Whether every cell holds the same choice (then lookup() is that choice
+  // in front of the light, without the cell's computation).
+  bool uniform() const { return uniform_; }
 
   bool empty() const { return !cells_; }
 
@@ -83,6 +92,7 @@ class planar_auto_table {
     const vec3 d = o - c_;
     const float h = glm::dot(d, nl_);
     if (!(h > 0.0f)) return light_sampling::area;
+    if (uniform_) return uniform_choice_;
     const float x0 = glm::dot(d, u1_), y0 = glm::dot(d, u2_);
     // Reflected into the quadrant x, y >= 0, n with it.
     const float x = std::abs(x0), y = std::abs(y0);
@@ -125,6 +135,8 @@ class planar_auto_table {
   vec3 c_{0.0f}, u1_{1, 0, 0}, u2_{0, 1, 0}, nl_{0, 0, 1};
   float s1_ = 1.0f, s2_ = 1.0f, sh_ = 1.0f;
   std::shared_ptr<const std::vector<std::uint8_t>> cells_;
+  bool uniform_ = false;
+  light_sampling uniform_choice_ = light_sampling::area;
 };
 
 }  // namespace mcrt
