@@ -186,7 +186,6 @@ class auto_choice {
   // Whether area sampling with variance v_area beats both other strategies
   // even at no variance of their own, v_rest being vr.
   static bool area_wins(float v_area, float vr, const auto_costs::shape_costs& c, const auto_params& p) {
-    if (vr == std::numeric_limits<float>::infinity()) return cheapest(c) == light_sampling::area;
     const float area = score(c.area, v_area, vr, c, p);
     return area <= score(c.solid_angle, 0.0f, vr, c, p) && area <= score(c.projected_solid_angle, 0.0f, vr, c, p);
   }
@@ -199,7 +198,10 @@ class auto_choice {
   //    sample, taken as c_rest plus the shape's cheapest strategy's cost.
   //    (The local product would add a cross term cost v / (c_rest vr) that
   //    wrongly favours the dearest, variance-free strategy where vr is small.)
+  // Where vr is infinite (nothing to gain at the point) only the cost counts
+  // (both forms' limit; the product itself would be infinite for all).
   static float score(float cost, float v, float vr, const auto_costs::shape_costs& c, const auto_params& p) {
+    if (vr == std::numeric_limits<float>::infinity()) return cost;
     if (p.image_variance > 0.0f)
       return cost / (p.rest_cost + std::min({c.area, c.solid_angle, c.projected_solid_angle})) + v / vr;
     return (cost + p.rest_cost) * (v + vr);
@@ -217,7 +219,6 @@ class auto_choice {
   light_sampling choose(const auto_costs::shape_costs& c, const auto_params& p = {}) const {
     if (!(sg_ > 0.0f)) return cheapest(c);
     const float vr = rest_variance(p);
-    if (vr == std::numeric_limits<float>::infinity()) return cheapest(c);
     const float area = score(c.area, v_area(), vr, c, p);
     const float sa = score(c.solid_angle, v_solid_angle(), vr, c, p);
     const float psa = score(c.projected_solid_angle, 0.0f, vr, c, p);
@@ -500,9 +501,8 @@ inline light_sampling choose_strategy(const sphere& s, const vec3& o, const vec3
     const float v_sa = r2 * (d2 - h * h) / (4.0f * d2 * h * h);  // tan^2(theta_c) sin^2(alpha) / 4
     // Omega_proj = pi sin^2(alpha) cos(theta_c) for a cap above the horizon.
     const float vr = p.rest_variance_at(pi * r2 / d2 * h / std::sqrt(d2));
-    if (vr == std::numeric_limits<float>::infinity() ||
-        auto_choice::score(c.solid_angle, 2.0f * v_sa, vr, c, p) <=
-            auto_choice::score(c.projected_solid_angle, 0.0f, vr, c, p))
+    if (auto_choice::score(c.solid_angle, 2.0f * v_sa, vr, c, p) <=
+        auto_choice::score(c.projected_solid_angle, 0.0f, vr, c, p))
       return light_sampling::solid_angle;
   }
   return auto_model(s, o, n).choose(c, p);
