@@ -100,9 +100,7 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
         glm::dvec3 mean(0.0);
         for (int s = 0; s < m; ++s) {
           px.start_sample(s);
-          const vec2 jit = px.pixel();
-          const ray r = cam.generate((static_cast<float>(x) + jit.x) * inv_w, (static_cast<float>(y) + jit.y) * inv_h);
-          const color v = Integrator::li(sc, r, px, set);
+          const color v = camera_sample<Integrator>(sc, cam, px, x, y, inv_w, inv_h, set);
           if (!all_finite(v)) continue;
           c[static_cast<std::size_t>(finite++)] = glm::dvec3(v);
           mean += glm::dvec3(v);

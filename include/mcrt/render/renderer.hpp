@@ -50,6 +50,16 @@ struct render_result {
 // about every `progress_interval`, and once at the end.
 using progress_callback = std::function<void(double, double)>;
 
+// One camera sample of pixel (x, y): the ray through the point of the pixel
+// the sampler gives (dimensions 0 and 1), and the radiance along it.
+template <class Integrator, class Scene, class PixelSampler>
+color camera_sample(const Scene& sc, const camera& cam, PixelSampler& ps, int x, int y, float inv_w, float inv_h,
+                    const path_settings& set) {
+  const vec2 j = ps.pixel();
+  const ray r = cam.generate((static_cast<float>(x) + j.x) * inv_w, (static_cast<float>(y) + j.y) * inv_h);
+  return Integrator::li(sc, r, ps, set);
+}
+
 template <class Integrator, class Scene, class Sampler>
 color render_pixel(const Scene& sc, const camera& cam, const render_settings& rs, const Sampler& sampler, int x, int y,
                    std::uint64_t& nonfinite) {
@@ -59,9 +69,7 @@ color render_pixel(const Scene& sc, const camera& cam, const render_settings& rs
   glm::dvec3 sum(0.0);
   for (int s = 0; s < rs.spp; ++s) {
     ps.start_sample(s);
-    const vec2 j = ps.pixel();
-    const ray r = cam.generate((static_cast<float>(x) + j.x) * inv_w, (static_cast<float>(y) + j.y) * inv_h);
-    const color c = Integrator::li(sc, r, ps, set);
+    const color c = camera_sample<Integrator>(sc, cam, ps, x, y, inv_w, inv_h, set);
     if (all_finite(c))
       sum += glm::dvec3(c);
     else
