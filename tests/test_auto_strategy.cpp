@@ -390,6 +390,48 @@ TEST(AutoTable, ReproducesARuleAlignedWithItsCells) {
   EXPECT_FALSE(table.uniform());
 }
 
+// Where the other choices are confined near the light, receivers beyond
+// the box of those cells get area sampling without a cell lookup: the
+// lookup still reproduces a rule aligned with the cells exactly, inside
+// the box and beyond it (most of the receivers here).
+TEST(AutoTable, AreaBeyondTheCellsOfOtherChoices) {
+  const rect r = xz_rect(-1.0f, 1.0f, -0.5f, 0.5f, 0.0f, true);  // facing -y
+  const vec3 c(0.0f), h1 = 0.5f * r.e1, h2 = 0.5f * r.e2;
+  const float s1 = glm::length(h1), s2 = glm::length(h2), sh = std::sqrt(s1 * s2);
+  const vec3 u1 = glm::normalize(h1), u2 = glm::normalize(h2);
+  // Cell boundaries: |x| = s1 and |y| = s2 (t = 1/2), h = sh / 3 (t = 1/4),
+  // and n . u1 = 0 (the octahedral map keeps its sign; the table's mirror
+  // symmetry reflects it with x).
+  const auto rule = [&](const vec3& o, const vec3& n) {
+    const float x = glm::dot(o - c, u1), y = glm::dot(o - c, u2), h = glm::dot(o - c, r.n);
+    if (std::abs(x) >= s1 || std::abs(y) >= s2 || h >= sh / 3.0f) return light_sampling::area;
+    return std::copysign(1.0f, x) * glm::dot(n, u1) < 0.0f ? light_sampling::solid_angle
+                                                           : light_sampling::projected_solid_angle;
+  };
+  const planar_auto_table table(c, h1, h2, r.n, rule);
+  EXPECT_FALSE(table.uniform());
+  EXPECT_NEAR(table.area_beyond()[0], s1, 1e-5f);
+  EXPECT_NEAR(table.area_beyond()[1], s2, 1e-5f);
+  EXPECT_NEAR(table.area_beyond()[2], sh / 3.0f, 1e-5f);
+  pcg32 rng(9, 2);
+  int checked = 0, inside = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const vec3 o(6.0f * rng.uniform() - 3.0f, -2.0f * rng.uniform() * rng.uniform() - 1e-4f, 4.0f * rng.uniform() - 2.0f);
+    const vec3 n = glm::normalize(vec3(2 * rng.uniform() - 1, 2 * rng.uniform() - 1, 2 * rng.uniform() - 1));
+    const float x = glm::dot(o - c, u1), y = glm::dot(o - c, u2), h = glm::dot(o - c, r.n);
+    // Skip receivers within rounding of a cell boundary (position or normal).
+    if (std::abs(std::abs(x) - s1) < 1e-4f || std::abs(std::abs(y) - s2) < 1e-4f || std::abs(h - sh / 3.0f) < 1e-4f)
+      continue;
+    if (std::abs(glm::dot(n, u1)) < 1e-4f) continue;
+    const light_sampling expected = rule(o, n);
+    if (expected != light_sampling::area) ++inside;
+    ASSERT_EQ(table.lookup(o, n), expected) << "receiver " << i;
+    ++checked;
+  }
+  EXPECT_GT(checked, 15000);
+  EXPECT_GT(inside, 500) << "the other choices must be met too";
+}
+
 // A table whose cells all hold one choice says so, and answers it in front
 // of the light without a cell (area behind it, as every table).
 TEST(AutoTable, UniformTableAnswersItsOneChoice) {

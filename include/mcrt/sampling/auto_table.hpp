@@ -78,6 +78,26 @@ class planar_auto_table {
     const std::uint8_t first = (*cells_)[0];
     uniform_ = std::all_of(cells_->begin(), cells_->end(), [&](std::uint8_t c) { return c == first; });
     uniform_choice_ = static_cast<light_sampling>(first);
+    // The box (in the light's frame) outside which every cell holds area
+    // sampling: the cells' upper ends, expanded, past the last cell of each
+    // coordinate that holds another choice. Outside it a lookup needs the
+    // receiver's position alone, not its normal or cell (most receivers,
+    // when the dearer strategies pay only close to the light).
+    int last[3] = {-1, -1, -1};
+    for (int ix = 0; ix < lateral_cells; ++ix)
+      for (int iy = 0; iy < lateral_cells; ++iy)
+        for (int ih = 0; ih < height_cells; ++ih)
+          for (int a = 0; a < normal_cells; ++a)
+            for (int b = 0; b < normal_cells; ++b)
+              if (static_cast<light_sampling>((*cells_)[index(ix, iy, ih, a, b)]) != light_sampling::area) {
+                last[0] = std::max(last[0], ix), last[1] = std::max(last[1], iy), last[2] = std::max(last[2], ih);
+              }
+    auto upper_end = [](int last_cell, int k, float scale) {
+      // Cell i covers t in [i / k, (i + 1) / k); the last cell reaches infinity.
+      return last_cell + 1 >= k ? infinity : expand(float(last_cell + 1) / float(k), scale);
+    };
+    area_beyond_ = {upper_end(last[0], lateral_cells, s1_), upper_end(last[1], lateral_cells, s2_),
+                    upper_end(last[2], height_cells, sh_)};
   }
 
   // Whether every cell holds the same choice (then lookup() is that choice
@@ -85,6 +105,10 @@ class planar_auto_table {
   bool uniform() const { return uniform_; }
 
   bool empty() const { return !cells_; }
+
+  // The box beyond which every receiver gets area sampling: |x|, |y| and h
+  // (light's frame) from which on no cell holds another choice.
+  const std::array<float, 3>& area_beyond() const { return area_beyond_; }
 
   // The tabulated choice at o for the unit normal n; area where o is not
   // in front of the light (h <= 0: nothing is sampled there).
@@ -96,6 +120,7 @@ class planar_auto_table {
     const float x0 = glm::dot(d, u1_), y0 = glm::dot(d, u2_);
     // Reflected into the quadrant x, y >= 0, n with it.
     const float x = std::abs(x0), y = std::abs(y0);
+    if (x >= area_beyond_[0] || y >= area_beyond_[1] || h >= area_beyond_[2]) return light_sampling::area;
     const float nx = std::copysign(1.0f, x0) * glm::dot(n, u1_), ny = std::copysign(1.0f, y0) * glm::dot(n, u2_);
     const float nz = glm::dot(n, nl_);
     // The four divisions as one packed one.
@@ -137,6 +162,7 @@ class planar_auto_table {
   std::shared_ptr<const std::vector<std::uint8_t>> cells_;
   bool uniform_ = false;
   light_sampling uniform_choice_ = light_sampling::area;
+  std::array<float, 3> area_beyond_{0.0f, 0.0f, 0.0f};  // x, y, h beyond which every cell holds area
 };
 
 }  // namespace mcrt
