@@ -221,6 +221,9 @@ class Settings:
     pixel_maps: list[str] = field(default_factory=list)  # scenes to map; none by default
     pixel_map_seeds: int = 8
     pixel_map_spp: int | None = None  # None: the sweep's largest spp
+    # Runs of each render whose median time is its time (renders of a few
+    # ms vary by 10-20 % run to run; the image is the same every run).
+    time_repeats: int = 1
 
     @property
     def configs(self) -> list[Config]:
@@ -324,6 +327,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="--benchmark_min_time in seconds per sampler (default: 0.5, 0.05 with --quick)")
     p.add_argument("--bench-repetitions", type=int, default=None,
                    help="benchmark repetitions, the median is reported (default: 3, 1 with --quick)")
+    p.add_argument("--time-repeats", type=int, default=1, metavar="R",
+                   help="run each render R times and take the median of its times (the image is the "
+                   "same every run; default: 1)")
     p.add_argument("--fresh", action="store_true",
                    help="discard the points of previous runs (cached references are kept)")
     p.add_argument("--report-only", action="store_true",
@@ -404,6 +410,9 @@ def resolve_settings(args: argparse.Namespace, argv: list[str]) -> Settings:
         problems.append(f"mcrt executable not found: {settings.mcrt} (build it, or pass --mcrt)")
     settings.pixel_maps = list(dict.fromkeys(args.pixel_maps or []))
     settings.pixel_map_seeds, settings.pixel_map_spp = args.pixel_map_seeds, args.pixel_map_spp
+    settings.time_repeats = args.time_repeats
+    if settings.time_repeats < 1:
+        problems.append("--time-repeats must be positive")
     if settings.pixel_map_seeds < 1 or (settings.pixel_map_spp is not None and settings.pixel_map_spp < 1):
         problems.append("--pixel-map-seeds and --pixel-map-spp must be positive")
     if problems:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import statistics
 import subprocess
 from pathlib import Path
 
@@ -32,7 +33,8 @@ def run_mcrt(settings: Settings, args: list[str]) -> subprocess.CompletedProcess
 
 def render(settings: Settings, scene: SceneInfo, config: Config, max_depth: int, spp: int,
            seed: int, image: Path) -> float:
-    """Render one image; return render_seconds from --stats.
+    """Render one image; return render_seconds from --stats (the median over
+    settings.time_repeats runs of the same render, which give the same image).
 
     The integrator, sampler and max depth that --stats reports are checked
     against those asked for, so a binary that ignored one cannot go unnoticed.
@@ -45,14 +47,17 @@ def render(settings: Settings, scene: SceneInfo, config: Config, max_depth: int,
             "--stats", str(stats), "--quiet"]
     if settings.threads is not None:
         args += ["--threads", str(settings.threads)]
-    run_mcrt(settings, args)
-    data = json.loads(stats.read_text(encoding="utf-8"))
-    stats.unlink(missing_ok=True)
-    for name, asked in (("integrator", config.integrator), ("sampler", config.sampler),
-                        ("max_depth", max_depth), ("light_sampling", config.strategy)):
-        if name in data and data[name] != asked:
-            raise McrtError(f"--stats reports {name} {data[name]!r}, asked for {asked!r}", 0, False)
-    return float(data["render_seconds"])
+    seconds = []
+    for _ in range(max(1, settings.time_repeats)):
+        run_mcrt(settings, args)
+        data = json.loads(stats.read_text(encoding="utf-8"))
+        stats.unlink(missing_ok=True)
+        for name, asked in (("integrator", config.integrator), ("sampler", config.sampler),
+                            ("max_depth", max_depth), ("light_sampling", config.strategy)):
+            if name in data and data[name] != asked:
+                raise McrtError(f"--stats reports {name} {data[name]!r}, asked for {asked!r}", 0, False)
+        seconds.append(float(data["render_seconds"]))
+    return statistics.median(seconds)
 
 
 def diff(settings: Settings, image: Path, reference: Path) -> dict[str, float]:

@@ -384,7 +384,9 @@ def write_report(settings: Settings, scenes: list[SceneInfo], tables: str,
         f"- Sweep: spp {', '.join(map(str, settings.spp))}; seeds {', '.join(map(str, settings.seeds))}; "
         "for each seed and spp every depth mode and configuration in turn",
         "- Time: `render_seconds` of `mcrt render --stats` (rendering only: no process start, "
-        "no scene parsing, no image output). Error: `mcrt diff --json` against the reference "
+        "no scene parsing, no image output)"
+        + (f", the median of {settings.time_repeats} runs of each render" if settings.time_repeats > 1 else "")
+        + ". Error: `mcrt diff --json` against the reference "
         "(relMSE as in pbrt: mean of (v−r)²/(r+0.01)²).",
         "- Efficiency: 1/(MSE × seconds) of each render; a configuration's is the geometric mean "
         "over its renders (every spp and seed), compared with the baseline "
