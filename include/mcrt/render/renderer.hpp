@@ -50,14 +50,19 @@ struct render_result {
 // about every `progress_interval`, and once at the end.
 using progress_callback = std::function<void(double, double)>;
 
-// One camera sample of pixel (x, y): the ray through the point of the pixel
-// the sampler gives (dimensions 0 and 1), and the radiance along it.
+// The camera ray of one sample of pixel (x, y): through the point of the
+// pixel the sampler gives (dimensions 0 and 1).
+template <class PixelSampler>
+ray camera_ray(const camera& cam, PixelSampler& ps, int x, int y, float inv_w, float inv_h) {
+  const vec2 j = ps.pixel();
+  return cam.generate((static_cast<float>(x) + j.x) * inv_w, (static_cast<float>(y) + j.y) * inv_h);
+}
+
+// One camera sample of pixel (x, y): its camera ray and the radiance along it.
 template <class Integrator, class Scene, class PixelSampler>
 color camera_sample(const Scene& sc, const camera& cam, PixelSampler& ps, int x, int y, float inv_w, float inv_h,
                     const path_settings& set) {
-  const vec2 j = ps.pixel();
-  const ray r = cam.generate((static_cast<float>(x) + j.x) * inv_w, (static_cast<float>(y) + j.y) * inv_h);
-  return Integrator::li(sc, r, ps, set);
+  return Integrator::li(sc, camera_ray(cam, ps, x, y, inv_w, inv_h), ps, set);
 }
 
 template <class Integrator, class Scene, class Sampler>
