@@ -121,8 +121,7 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
         const int x = x0 + i * k;
         // The surface at the pixel's centre: its albedo, if diffuse.
         hit_record rec;
-        if (sc.hit(cam.generate((static_cast<float>(x) + 0.5f) * inv_w, (static_cast<float>(y) + 0.5f) * inv_h),
-                   sc.ray_epsilon, infinity, rec))
+        if (sc.hit(pixel_ray(cam, x, y, vec2(0.5f), inv_w, inv_h), sc.ray_epsilon, infinity, rec))
           if (const auto* l = std::get_if<lambertian>(&sc.materials[rec.material])) {
             const double a = (double(l->albedo.r) + l->albedo.g + l->albedo.b) / 3.0;
             albedo2 += a * a;
@@ -144,11 +143,9 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
         if (k_rays) {
           // What the camera rays meet first: its two-sample variance out,
           // its K-ray variance in (header).
-          for (int i = 0; i < k_rays; ++i) {
-            const vec2 j = px.stream().uniform2();
-            const ray r = cam.generate((static_cast<float>(x) + j.x) * inv_w, (static_cast<float>(y) + j.y) * inv_h);
-            ek[static_cast<std::size_t>(i)] = glm::dvec3(radiance_met_first(sc, r));
-          }
+          for (int i = 0; i < k_rays; ++i)
+            ek[static_cast<std::size_t>(i)] =
+                glm::dvec3(radiance_met_first(sc, pixel_ray(cam, x, y, px.stream().uniform2(), inv_w, inv_h)));
           var += sample_variance(ek.data(), k_rays) - sample_variance(e.data(), finite);
         }
         sum += var;

@@ -50,12 +50,16 @@ struct render_result {
 // about every `progress_interval`, and once at the end.
 using progress_callback = std::function<void(double, double)>;
 
+// The camera ray through the point j in [0, 1)^2 of pixel (x, y).
+inline ray pixel_ray(const camera& cam, int x, int y, vec2 j, float inv_w, float inv_h) {
+  return cam.generate((static_cast<float>(x) + j.x) * inv_w, (static_cast<float>(y) + j.y) * inv_h);
+}
+
 // The camera ray of one sample of pixel (x, y): through the point of the
 // pixel the sampler gives (dimensions 0 and 1).
 template <class PixelSampler>
 ray camera_ray(const camera& cam, PixelSampler& ps, int x, int y, float inv_w, float inv_h) {
-  const vec2 j = ps.pixel();
-  return cam.generate((static_cast<float>(x) + j.x) * inv_w, (static_cast<float>(y) + j.y) * inv_h);
+  return pixel_ray(cam, x, y, ps.pixel(), inv_w, inv_h);
 }
 
 // One camera sample of pixel (x, y): its camera ray and the radiance along it.

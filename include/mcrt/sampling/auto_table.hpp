@@ -57,6 +57,9 @@ class planar_auto_table {
     u2_ = half2 / s2_;
     sh_ = std::sqrt(s1_ * s2_);
     auto cells = std::make_shared<std::vector<std::uint8_t>>(cell_count);
+    // The last cell of each position coordinate that holds another choice
+    // than area (for the box of area_beyond_ below).
+    int last[3] = {-1, -1, -1};
     for (int ix = 0; ix < lateral_cells; ++ix)
       for (int iy = 0; iy < lateral_cells; ++iy)
         for (int ih = 0; ih < height_cells; ++ih) {
@@ -69,7 +72,10 @@ class planar_auto_table {
               const vec3 nloc = octahedral_decode(centre_of(a, normal_cells, -1.0f, 1.0f),
                                                   centre_of(b, normal_cells, -1.0f, 1.0f));
               const vec3 n = glm::normalize(nloc.x * u1_ + nloc.y * u2_ + nloc.z * nl_);
-              (*cells)[index(ix, iy, ih, a, b)] = static_cast<std::uint8_t>(choose(o, n));
+              const light_sampling c = choose(o, n);
+              (*cells)[index(ix, iy, ih, a, b)] = static_cast<std::uint8_t>(c);
+              if (c != light_sampling::area)
+                last[0] = std::max(last[0], ix), last[1] = std::max(last[1], iy), last[2] = std::max(last[2], ih);
             }
         }
     cells_ = std::move(cells);
@@ -83,15 +89,6 @@ class planar_auto_table {
     // coordinate that holds another choice. Outside it a lookup needs the
     // receiver's position alone, not its normal or cell (most receivers,
     // when the dearer strategies pay only close to the light).
-    int last[3] = {-1, -1, -1};
-    for (int ix = 0; ix < lateral_cells; ++ix)
-      for (int iy = 0; iy < lateral_cells; ++iy)
-        for (int ih = 0; ih < height_cells; ++ih)
-          for (int a = 0; a < normal_cells; ++a)
-            for (int b = 0; b < normal_cells; ++b)
-              if (static_cast<light_sampling>((*cells_)[index(ix, iy, ih, a, b)]) != light_sampling::area) {
-                last[0] = std::max(last[0], ix), last[1] = std::max(last[1], iy), last[2] = std::max(last[2], ih);
-              }
     auto upper_end = [](int last_cell, int k, float scale) {
       // Cell i covers t in [i / k, (i + 1) / k); the last cell reaches infinity.
       return last_cell + 1 >= k ? infinity : expand(float(last_cell + 1) / float(k), scale);
