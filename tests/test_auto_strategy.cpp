@@ -390,6 +390,44 @@ TEST(AutoTable, ReproducesARuleAlignedWithItsCells) {
   EXPECT_FALSE(table.uniform());
 }
 
+// The sphere's table: a rule of the distance and of the normal's angle to
+// the centre alone, aligned with the cells (t = r^2 / d^2 = 1/4, i.e. d =
+// 2r, and cos = 0, 1/2), reproduced exactly at random receivers and
+// normals of any length and direction (the table's symmetry about the
+// direction to the centre); inside the sphere, area.
+TEST(AutoTable, SphereReproducesARuleAlignedWithItsCells) {
+  const vec3 c(0.3f, 1.0f, -0.2f);
+  const float radius = 0.5f;
+  const auto rule = [&](const vec3& o, const vec3& n) {
+    const vec3 v = c - o;
+    const float cs = glm::dot(v, n) / (glm::length(v) * glm::length(n));
+    if (glm::length(v) < 2.0f * radius) return cs < 0.0f ? light_sampling::area : light_sampling::projected_solid_angle;
+    return cs < 0.5f ? light_sampling::projected_solid_angle : light_sampling::solid_angle;
+  };
+  const sphere_auto_table table(c, radius, rule);
+  EXPECT_FALSE(table.uniform());
+  pcg32 rng(9, 2);
+  int checked = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const vec3 dir = glm::normalize(vec3(2 * rng.uniform() - 1, 2 * rng.uniform() - 1, 2 * rng.uniform() - 1));
+    const float dist = radius * (1.0f + 0.01f) + 4.0f * rng.uniform();
+    const vec3 o = c + dist * dir;
+    const vec3 n = (0.1f + 3.0f * rng.uniform()) *
+                   glm::normalize(vec3(2 * rng.uniform() - 1, 2 * rng.uniform() - 1, 2 * rng.uniform() - 1));
+    const float cs = glm::dot(-dir, glm::normalize(n));
+    if (std::abs(dist - 2.0f * radius) < 1e-4f || std::abs(cs) < 1e-4f || std::abs(cs - 0.5f) < 1e-4f) continue;
+    ASSERT_EQ(table.lookup(o, n), rule(o, n)) << "receiver " << i;
+    ++checked;
+  }
+  EXPECT_GT(checked, 19000);
+  EXPECT_EQ(table.lookup(c + vec3(0.0f, 0.2f, 0.0f), vec3(0, 1, 0)), light_sampling::area);  // inside
+  // One choice everywhere: answered without a cell.
+  const sphere_auto_table one(c, radius, [](const vec3&, const vec3&) { return light_sampling::solid_angle; });
+  EXPECT_TRUE(one.uniform());
+  EXPECT_EQ(one.lookup(c + vec3(0.0f, -3.0f, 0.0f), vec3(1, 0, 0)), light_sampling::solid_angle);
+  EXPECT_EQ(one.lookup(c, vec3(1, 0, 0)), light_sampling::area);
+}
+
 // Where the other choices are confined near the light, receivers beyond
 // the box of those cells get area sampling without a cell lookup: the
 // lookup still reproduces a rule aligned with the cells exactly, inside
@@ -450,7 +488,7 @@ TEST(AutoTable, UniformTableAnswersItsOneChoice) {
 }
 
 // The tabulated rule against the rule itself at random receivers around a
-// rectangle and a disk (as check_agreement's): the same choice at most of
+// rectangle, a disk and a sphere (as check_agreement's): the same choice at most of
 // them (they differ only in cells the rule's boundary crosses).
 template <class Auto, class Shape>
 double tabulated_agreement(const Shape& shape, const auto_params& params = {}) {
@@ -471,16 +509,21 @@ TEST(AutoTable, AgreesWithTheRuleAtMostReceivers) {
   const double rect_share = tabulated_agreement<rect_auto_sampler>(xz_rect(-1.0f, 1.0f, -0.8f, 0.8f, 0.0f, true));
   const double disk_share =
       tabulated_agreement<ellipse_auto_sampler>(ellipse::make({0, 0, 0}, {1.0f, 0, 0}, {0, 0, 0.8f}));
+  const double sphere_share = tabulated_agreement<sphere_auto_sampler>(sphere{vec3(0.0f, 0.6f, 0.0f), 0.5f});
   EXPECT_GE(rect_share, 0.9);
   EXPECT_GE(disk_share, 0.9);
+  EXPECT_GE(sphere_share, 0.9);
   // With v_rest from the image's noise (it varies with the light's
   // projected solid angle, which the cells resolve as they resolve v_area).
   EXPECT_GE(tabulated_agreement<rect_auto_sampler>(xz_rect(-1.0f, 1.0f, -0.8f, 0.8f, 0.0f, true), noise_params()), 0.9);
   EXPECT_GE(tabulated_agreement<ellipse_auto_sampler>(ellipse::make({0, 0, 0}, {1.0f, 0, 0}, {0, 0, 0.8f}), noise_params()),
             0.9);
+  EXPECT_GE(tabulated_agreement<sphere_auto_sampler>(sphere{vec3(0.0f, 0.6f, 0.0f), 0.5f}, noise_params()), 0.9);
   ::testing::Test::RecordProperty("rect_share", std::to_string(rect_share));
   ::testing::Test::RecordProperty("disk_share", std::to_string(disk_share));
-  std::printf("tabulated = rule at %.3f (rectangle), %.3f (disk) of the receivers\n", rect_share, disk_share);
+  ::testing::Test::RecordProperty("sphere_share", std::to_string(sphere_share));
+  std::printf("tabulated = rule at %.3f (rectangle), %.3f (disk), %.3f (sphere) of the receivers\n", rect_share,
+              disk_share, sphere_share);
 }
 
 }  // namespace

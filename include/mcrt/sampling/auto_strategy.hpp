@@ -41,9 +41,10 @@
 // Where a receiver is close to a planar light (within a fraction of its
 // size) g peaks near the light's nearest point and no fixed quadrature
 // sees the peak; the model then takes the peak's own variance (see
-// auto_choice::v_area). auto_sampler evaluates the rule of a planar light
-// once per cell of a table of receiver positions and normals
-// (auto_table.hpp), so a shading point pays a lookup, not the rule.
+// auto_choice::v_area). auto_sampler evaluates the rule of a light once
+// per cell of a table of receiver positions and normals (auto_table.hpp;
+// for a sphere, of distances and normals' angles to its centre), so a
+// shading point pays a lookup, not the rule.
 #include <algorithm>
 #include <limits>
 #if defined(__SSE2__)
@@ -526,16 +527,16 @@ class tabulated_planar_rule {
       : table_(c, h1, h2, nl, [&](const vec3& o, const vec3& n) { return rule.choose(o, n, p); }) {}
   planar_auto_table table_;
 };
-// Spheres: the rule itself (its early test for caps above the horizon is
-// cheap).
-class sphere_rule {
+// Spheres: the rule, tabulated over the receiver's distance and the
+// normal's angle to the centre (auto_table.hpp), which is all it depends on.
+class tabulated_sphere_rule {
  public:
-  sphere_rule(const sphere& s, const auto_params& p) : s_(s), p_(p) {}
-  light_sampling choose(const vec3& o, const vec3& n) const { return choose_strategy(s_, o, n, p_); }
+  tabulated_sphere_rule(const sphere& s, const auto_params& p)
+      : table_(s.center, s.radius, [&](const vec3& o, const vec3& n) { return choose_strategy(s, o, n, p); }) {}
+  light_sampling choose(const vec3& o, const vec3& n) const { return table_.lookup(o, n); }
 
  private:
-  sphere s_;
-  auto_params p_;
+  sphere_auto_table table_;
 };
 template <class Shape>
 struct auto_rule_of {
@@ -543,7 +544,7 @@ struct auto_rule_of {
 };
 template <>
 struct auto_rule_of<sphere> {
-  using type = sphere_rule;
+  using type = tabulated_sphere_rule;
 };
 
 // The strategy itself: the three samplers of one shape and the per-point
