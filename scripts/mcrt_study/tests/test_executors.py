@@ -302,9 +302,20 @@ class ResumeTest(ExecutorTestCase):
         patcher.start()
         self.addCleanup(patcher.stop)
 
+    def split_failing(self) -> tuple[list[str], list[str]]:
+        """The calls, as (the failing configuration's at depth 1, the others). With two workers
+        a second point of the failing configuration may already be in flight when the first
+        one's failure comes back (only points not yet submitted are skipped), so how many of
+        its points are called depends on timing: at least one, and only its depth-1 points."""
+        prefix = FAILING.label.replace("/", "_") + f"-{DIRECT_MAX_DEPTH}-"
+        calls = self.calls()
+        return [c for c in calls if c.startswith(prefix)], [c for c in calls if not c.startswith(prefix)]
+
     def test_crashed_run_resumes_from_its_point_files(self) -> None:
         rows, settings, _ = self.study("run", Backend("local", 2))
-        self.assertEqual(len(self.calls()), 29)  # 28 points and the failing configuration's one
+        failing_calls, others = self.split_failing()
+        self.assertEqual(len(others), 28)  # 28 points, and one or more of the failing configuration's
+        self.assertTrue(1 <= len(failing_calls) <= len(SPP) * len(SEEDS), failing_calls)
         # The driver died: no CSV; five points were never finished; a half-written point file; a
         # stray copy of a point with another time.
         out, points = settings.out, settings.out / POINTS_DIR
@@ -324,8 +335,11 @@ class ResumeTest(ExecutorTestCase):
         rows2, settings2, csv2 = self.study("run", Backend("local", 2))
         again = [f"{r['integrator']}_{r['sampler']}_{r['strategy']}-{r['max_depth']}-{r['spp']}-{r['seed']}"
                  for r in lost_rows]
+        failing_calls, others = self.split_failing()
+        self.assertEqual(others, sorted(again))
         failing = f"{FAILING.label.replace('/', '_')}-1-4-1"
-        self.assertEqual(self.calls(), sorted(again + [failing]))
+        self.assertIn(failing, failing_calls)
+        self.assertLessEqual(len(failing_calls), len(SPP) * len(SEEDS))
         self.assertEqual(sorted(rows2, key=row_key), sorted(rows, key=row_key))
         self.assertEqual(len(csv2.splitlines()), 1 + len(rows))
         copied = [r for r in rows2 if row_key(r) == row_key(copy["row"])]
