@@ -36,6 +36,29 @@
 
 namespace mcrt {
 
+// The cells of a tabulated choice (one byte each, a light_sampling), shared
+// by the copies of a light, and whether they all hold one choice (then a
+// lookup needs no cell).
+class choice_cells {
+ public:
+  choice_cells() = default;
+  explicit choice_cells(std::vector<std::uint8_t> cells)
+      : cells_(std::make_shared<const std::vector<std::uint8_t>>(std::move(cells))) {
+    const std::uint8_t first = cells_->front();
+    uniform_ = std::all_of(cells_->begin(), cells_->end(), [&](std::uint8_t c) { return c == first; });
+    uniform_choice_ = static_cast<light_sampling>(first);
+  }
+
+  bool uniform() const { return uniform_; }
+  light_sampling uniform_choice() const { return uniform_choice_; }
+  light_sampling operator[](std::size_t i) const { return static_cast<light_sampling>((*cells_)[i]); }
+
+ private:
+  std::shared_ptr<const std::vector<std::uint8_t>> cells_;
+  bool uniform_ = false;
+  light_sampling uniform_choice_ = light_sampling::area;
+};
+
 class planar_auto_table {
  public:
   // Cells per coordinate: lateral (over the quadrant), height, and each of
@@ -56,7 +79,7 @@ class planar_auto_table {
     u1_ = half1 / s1_;
     u2_ = half2 / s2_;
     sh_ = std::sqrt(s1_ * s2_);
-    auto cells = std::make_shared<std::vector<std::uint8_t>>(cell_count);
+    std::vector<std::uint8_t> cells(cell_count);
     // The last cell of each position coordinate that holds another choice
     // than area (for the box of area_beyond_ below).
     int last[3] = {-1, -1, -1};
@@ -73,17 +96,14 @@ class planar_auto_table {
                                                   centre_of(b, normal_cells, -1.0f, 1.0f));
               const vec3 n = glm::normalize(nloc.x * u1_ + nloc.y * u2_ + nloc.z * nl_);
               const light_sampling c = choose(o, n);
-              (*cells)[index(ix, iy, ih, a, b)] = static_cast<std::uint8_t>(c);
+              cells[index(ix, iy, ih, a, b)] = static_cast<std::uint8_t>(c);
               if (c != light_sampling::area)
                 last[0] = std::max(last[0], ix), last[1] = std::max(last[1], iy), last[2] = std::max(last[2], ih);
             }
         }
-    cells_ = std::move(cells);
     // One choice in every cell (a light far from everything the image
     // holds, or an image whose noise is all elsewhere): no lookup needed.
-    const std::uint8_t first = (*cells_)[0];
-    uniform_ = std::all_of(cells_->begin(), cells_->end(), [&](std::uint8_t c) { return c == first; });
-    uniform_choice_ = static_cast<light_sampling>(first);
+    cells_ = choice_cells(std::move(cells));
     // The box (in the light's frame) outside which every cell holds area
     // sampling: the cells' upper ends, expanded, past the last cell of each
     // coordinate that holds another choice. Outside it a lookup needs the
@@ -99,9 +119,7 @@ class planar_auto_table {
 
   // Whether every cell holds the same choice (then lookup() is that choice
   // in front of the light, without the cell's computation).
-  bool uniform() const { return uniform_; }
-
-  bool empty() const { return !cells_; }
+  bool uniform() const { return cells_.uniform(); }
 
   // The box beyond which every receiver gets area sampling: |x|, |y| and h
   // (light's frame) from which on no cell holds another choice.
@@ -113,7 +131,7 @@ class planar_auto_table {
     const vec3 d = o - c_;
     const float h = glm::dot(d, nl_);
     if (!(h > 0.0f)) return light_sampling::area;
-    if (uniform_) return uniform_choice_;
+    if (cells_.uniform()) return cells_.uniform_choice();
     const float x0 = glm::dot(d, u1_), y0 = glm::dot(d, u2_);
     // Reflected into the quadrant x, y >= 0, n with it.
     const float x = std::abs(x0), y = std::abs(y0);
@@ -133,7 +151,7 @@ class planar_auto_table {
     const int iy = cell(y * inv[2], lateral_cells, 0.0f, 1.0f);
     const int ih = cell(h * inv[3], height_cells, 0.0f, 1.0f);
     const int ia = cell(a, normal_cells, -1.0f, 1.0f), ib = cell(b, normal_cells, -1.0f, 1.0f);
-    return static_cast<light_sampling>((*cells_)[index(ix, iy, ih, ia, ib)]);
+    return cells_[index(ix, iy, ih, ia, ib)];
   }
 
  private:
@@ -156,9 +174,7 @@ class planar_auto_table {
 
   vec3 c_{0.0f}, u1_{1, 0, 0}, u2_{0, 1, 0}, nl_{0, 0, 1};
   float s1_ = 1.0f, s2_ = 1.0f, sh_ = 1.0f;
-  std::shared_ptr<const std::vector<std::uint8_t>> cells_;
-  bool uniform_ = false;
-  light_sampling uniform_choice_ = light_sampling::area;
+  choice_cells cells_;
   std::array<float, 3> area_beyond_{0.0f, 0.0f, 0.0f};  // x, y, h beyond which every cell holds area
 };
 
@@ -182,24 +198,20 @@ class sphere_auto_table {
   // The sphere's centre and radius; choose(o, n) the rule to tabulate.
   template <class Rule>
   sphere_auto_table(const vec3& centre, float radius, const Rule& choose) : c_(centre), r2_(radius * radius) {
-    auto cells = std::make_shared<std::vector<std::uint8_t>>(std::size_t(distance_cells) * cosine_cells);
+    std::vector<std::uint8_t> cells(std::size_t(distance_cells) * cosine_cells);
     for (int i = 0; i < distance_cells; ++i) {
       const float t = (float(i) + 0.5f) / float(distance_cells);
       const vec3 o = centre + vec3(radius / std::sqrt(t), 0.0f, 0.0f);  // the centre is along -x from o
       for (int j = 0; j < cosine_cells; ++j) {
         const float cs = -1.0f + 2.0f * (float(j) + 0.5f) / float(cosine_cells);
         const vec3 n(-cs, std::sqrt(std::max(1.0f - cs * cs, 0.0f)), 0.0f);
-        (*cells)[std::size_t(i) * cosine_cells + j] = static_cast<std::uint8_t>(choose(o, n));
+        cells[std::size_t(i) * cosine_cells + j] = static_cast<std::uint8_t>(choose(o, n));
       }
     }
-    cells_ = std::move(cells);
-    const std::uint8_t first = (*cells_)[0];
-    uniform_ = std::all_of(cells_->begin(), cells_->end(), [&](std::uint8_t c) { return c == first; });
-    uniform_choice_ = static_cast<light_sampling>(first);
+    cells_ = choice_cells(std::move(cells));
   }
 
-  bool uniform() const { return uniform_; }
-  bool empty() const { return !cells_; }
+  bool uniform() const { return cells_.uniform(); }
 
   // The tabulated choice at o for the normal n (of any length); area inside
   // the sphere.
@@ -208,20 +220,18 @@ class sphere_auto_table {
     const float d2 = glm::dot(v, v);
     const float t = r2_ / d2;
     if (!(t < 1.0f)) return light_sampling::area;
-    if (uniform_) return uniform_choice_;
+    if (cells_.uniform()) return cells_.uniform_choice();
     const float cs = glm::dot(v, n) / std::sqrt(d2 * glm::dot(n, n));
     const int i = std::min(int(t * float(distance_cells)), distance_cells - 1);
     const float f = (cs + 1.0f) * (0.5f * float(cosine_cells));
     const int j = f >= 0.0f ? std::min(int(f), cosine_cells - 1) : 0;  // NaN (n = 0) and rounding clamped
-    return static_cast<light_sampling>((*cells_)[std::size_t(i) * cosine_cells + j]);
+    return cells_[std::size_t(i) * cosine_cells + j];
   }
 
  private:
   vec3 c_{0.0f};
   float r2_ = 1.0f;
-  std::shared_ptr<const std::vector<std::uint8_t>> cells_;
-  bool uniform_ = false;
-  light_sampling uniform_choice_ = light_sampling::area;
+  choice_cells cells_;
 };
 
 }  // namespace mcrt
