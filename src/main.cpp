@@ -121,7 +121,9 @@ int run_render(const render_options& opt) {
   }
 
   render_result res = render_scene(ls.world, cam, rs, opt.quiet ? progress_callback{} : progress_callback(print_progress));
-  if (noise) res.seconds += noise->seconds;  // the pilot is part of the image's time
+  // The pilot and the set-up of the lights `auto` samples are part of the image's time.
+  if (noise) res.seconds += noise->seconds;
+  res.seconds += ls.auto_setup_seconds;
   const double samples = static_cast<double>(rs.width) * rs.height * rs.spp;
   const std::string strategy_used = strategy_summary(ls.world);
   if (res.nonfinite_samples && !opt.quiet)
@@ -156,6 +158,7 @@ int run_render(const render_options& opt) {
     j["rr_depth"] = rs.rr_depth;
     j["scene"] = ls.name;
     j["nonfinite_samples"] = res.nonfinite_samples;
+    if (ls.auto_lights > 0) j["auto_setup_seconds"] = ls.auto_setup_seconds;
     if (noise) {
       j["auto_pilot_seconds"] = noise->seconds;
       j["auto_image_variance"] = noise->image_variance;

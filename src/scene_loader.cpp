@@ -1,5 +1,6 @@
 #include "scene_loader.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -257,7 +258,7 @@ constexpr const char* strategy_names = "area, solid-angle, projected-solid-angle
 void read_object(const reader& rd, const json& o, const std::string& path, scene& world,
                  const std::map<std::string, std::uint32_t>& material_ids,
                  std::optional<light_sampling> override_strategy, ellipse_map map, const auto_params& ap,
-                 bool auto_pilot, int& auto_lights) {
+                 bool auto_pilot, int& auto_lights, double& auto_setup_seconds) {
   if (!o.is_object()) rd.ctx.fail(path, std::string("expected an object, got ") + type_name(o));
   std::string type = rd.string(o, path, "type");
   const std::string mat_name = rd.string(o, path, "material");
@@ -309,7 +310,11 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
       auto_params lp = ap;
       const color e = std::get<diffuse_light>(world.materials[mat]).emit;
       lp.radiance = (e.r + e.g + e.b) / 3.0f;
+      // Its set-up (the rule's constants and its table's cells, not yet
+      // evaluated) is part of the image's time (loaded_scene).
+      const auto start = std::chrono::steady_clock::now();
       add_light(world, shape, mat, strategy, map, lp);
+      auto_setup_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       return;
     }
     add_light(world, shape, mat, strategy, map, ap);
@@ -417,7 +422,7 @@ loaded_scene load_scene(const std::string& path, std::optional<light_sampling> o
   if (objs.empty()) ctx.fail("objects", "the scene has no objects");
   for (std::size_t i = 0; i < objs.size(); ++i)
     read_object(rd, objs[i], "objects[" + std::to_string(i) + "]", out.world, ids, override_strategy, map, ap, auto_pilot,
-                out.auto_lights);
+                out.auto_lights, out.auto_setup_seconds);
 
   // Self-intersection guard proportional to the scene's coordinates: a few
   // thousand float ulps of the largest coordinate (1.1e-3 for the 555-unit

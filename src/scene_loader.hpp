@@ -32,6 +32,9 @@ struct loaded_scene {
   camera_desc cam;
   int spp = 100, max_depth = 50;
   int auto_lights = 0;  // lights sampled by `auto`
+  // Time spent making those lights' samplers (seconds): `mcrt render` counts
+  // it in the image's time, as it does the noise pilot.
+  double auto_setup_seconds = 0.0;
 };
 
 // Which area-preserving map of the spherical ellipse samples an ellipse by

@@ -5,12 +5,15 @@
 // 0.01 per family, Sidak-corrected, fixed seeds: support/chi2.hpp).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <type_traits>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "mcrt/core/rng.hpp"
@@ -300,8 +303,9 @@ void check_monotone(const Shape& shape, bool sphere_shape) {
       ASSERT_LE(cost(c), last) << "receiver " << i << ", V = " << noise[j];
       if (cost(c) < last && j > 0) ++moved;
       last = cost(c);
-      if (j + 1 == noise.size())
+      if (j + 1 == noise.size()) {
         EXPECT_EQ(c, sphere_shape ? light_sampling::solid_angle : light_sampling::area) << "receiver " << i;
+      }
     }
     if (dist < 1.0f && first != light_sampling::area) ++near_not_area;
   }
@@ -387,7 +391,6 @@ TEST(AutoTable, ReproducesARuleAlignedWithItsCells) {
     ++checked;
   }
   EXPECT_GT(checked, 19000);
-  EXPECT_FALSE(table.uniform());
 }
 
 // The sphere's table: a rule of the distance and of the normal's angle to
@@ -405,7 +408,6 @@ TEST(AutoTable, SphereReproducesARuleAlignedWithItsCells) {
     return cs < 0.5f ? light_sampling::projected_solid_angle : light_sampling::solid_angle;
   };
   const sphere_auto_table table(c, radius, rule);
-  EXPECT_FALSE(table.uniform());
   pcg32 rng(9, 2);
   int checked = 0;
   for (int i = 0; i < 20000; ++i) {
@@ -421,65 +423,87 @@ TEST(AutoTable, SphereReproducesARuleAlignedWithItsCells) {
   }
   EXPECT_GT(checked, 19000);
   EXPECT_EQ(table.lookup(c + vec3(0.0f, 0.2f, 0.0f), vec3(0, 1, 0)), light_sampling::area);  // inside
-  // One choice everywhere: answered without a cell.
-  const sphere_auto_table one(c, radius, [](const vec3&, const vec3&) { return light_sampling::solid_angle; });
-  EXPECT_TRUE(one.uniform());
-  EXPECT_EQ(one.lookup(c + vec3(0.0f, -3.0f, 0.0f), vec3(1, 0, 0)), light_sampling::solid_angle);
-  EXPECT_EQ(one.lookup(c, vec3(1, 0, 0)), light_sampling::area);
 }
 
-// Where the other choices are confined near the light, receivers beyond
-// the box of those cells get area sampling without a cell lookup: the
-// lookup still reproduces a rule aligned with the cells exactly, inside
-// the box and beyond it (most of the receivers here).
-TEST(AutoTable, AreaBeyondTheCellsOfOtherChoices) {
+// The cells are evaluated when a lookup first meets them, each once: the
+// rule is called once per distinct cell a set of receivers falls in (here
+// the receivers of two walls and a floor, whose normals are three), not
+// for the table's million cells, and a second pass over the receivers
+// calls it no more. Behind the light (h <= 0) area, without a cell.
+TEST(AutoTable, EvaluatesEachCellOnceWhenFirstMet) {
   const rect r = xz_rect(-1.0f, 1.0f, -0.5f, 0.5f, 0.0f, true);  // facing -y
   const vec3 c(0.0f), h1 = 0.5f * r.e1, h2 = 0.5f * r.e2;
-  const float s1 = glm::length(h1), s2 = glm::length(h2), sh = std::sqrt(s1 * s2);
-  const vec3 u1 = glm::normalize(h1), u2 = glm::normalize(h2);
-  // Cell boundaries: |x| = s1 and |y| = s2 (t = 1/2), h = sh / 3 (t = 1/4),
-  // and n . u1 = 0 (the octahedral map keeps its sign; the table's mirror
-  // symmetry reflects it with x).
-  const auto rule = [&](const vec3& o, const vec3& n) {
-    const float x = glm::dot(o - c, u1), y = glm::dot(o - c, u2), h = glm::dot(o - c, r.n);
-    if (std::abs(x) >= s1 || std::abs(y) >= s2 || h >= sh / 3.0f) return light_sampling::area;
-    return std::copysign(1.0f, x) * glm::dot(n, u1) < 0.0f ? light_sampling::solid_angle
-                                                           : light_sampling::projected_solid_angle;
+  auto calls = std::make_shared<int>(0);
+  const planar_auto_table table(c, h1, h2, r.n, [calls](const vec3& o, const vec3&) {
+    ++*calls;
+    return o.x < 0.0f ? light_sampling::solid_angle : light_sampling::area;
+  });
+  EXPECT_EQ(*calls, 0) << "no cell is evaluated before a lookup";
+  struct receiver {
+    vec3 o, n;
   };
-  const planar_auto_table table(c, h1, h2, r.n, rule);
-  EXPECT_FALSE(table.uniform());
-  EXPECT_NEAR(table.area_beyond()[0], s1, 1e-5f);
-  EXPECT_NEAR(table.area_beyond()[1], s2, 1e-5f);
-  EXPECT_NEAR(table.area_beyond()[2], sh / 3.0f, 1e-5f);
-  pcg32 rng(9, 2);
-  int checked = 0, inside = 0;
-  for (int i = 0; i < 20000; ++i) {
-    const vec3 o(6.0f * rng.uniform() - 3.0f, -2.0f * rng.uniform() * rng.uniform() - 1e-4f, 4.0f * rng.uniform() - 2.0f);
-    const vec3 n = glm::normalize(vec3(2 * rng.uniform() - 1, 2 * rng.uniform() - 1, 2 * rng.uniform() - 1));
-    const float x = glm::dot(o - c, u1), y = glm::dot(o - c, u2), h = glm::dot(o - c, r.n);
-    // Skip receivers within rounding of a cell boundary (position or normal).
-    if (std::abs(std::abs(x) - s1) < 1e-4f || std::abs(std::abs(y) - s2) < 1e-4f || std::abs(h - sh / 3.0f) < 1e-4f)
-      continue;
-    if (std::abs(glm::dot(n, u1)) < 1e-4f) continue;
-    const light_sampling expected = rule(o, n);
-    if (expected != light_sampling::area) ++inside;
-    ASSERT_EQ(table.lookup(o, n), expected) << "receiver " << i;
-    ++checked;
+  std::vector<receiver> receivers;
+  pcg32 rng(10, 3);
+  for (int i = 0; i < 3000; ++i) {
+    const float a = 4.0f * rng.uniform() - 2.0f, b = -3.0f * rng.uniform();
+    receivers.push_back({vec3(-2.0f, b, a), vec3(1, 0, 0)});  // left wall
+    receivers.push_back({vec3(a, b, 2.0f), vec3(0, 0, -1)});  // back wall
+    receivers.push_back({vec3(a, -3.0f, b + 1.5f), vec3(0, 1, 0)});  // floor
   }
-  EXPECT_GT(checked, 15000);
-  EXPECT_GT(inside, 500) << "the other choices must be met too";
+  for (const receiver& q : receivers) (void)table.lookup(q.o, q.n);
+  const int first = *calls;
+  EXPECT_GT(first, 50);
+  EXPECT_LT(first, 5000) << "a few thousand of the " << planar_auto_table::cell_count << " cells";
+  for (const receiver& q : receivers) (void)table.lookup(q.o, q.n);
+  EXPECT_EQ(*calls, first) << "a met cell is not evaluated again";
+  EXPECT_EQ(table.lookup(vec3(0.3f, 2.0f, 0.1f), vec3(0, 1, 0)), light_sampling::area);  // behind the light
+  EXPECT_EQ(*calls, first);
 }
 
-// A table whose cells all hold one choice says so, and answers it in front
-// of the light without a cell (area behind it, as every table).
-TEST(AutoTable, UniformTableAnswersItsOneChoice) {
+// Copies of a table share its cells, and threads that meet cells at once
+// get the rule's choice at each cell's centre, the same as one thread does
+// (a cell's evaluation is a pure function of the cell; the race to store
+// it stores equal bytes). A rule depending on every coordinate the cells
+// resolve, so that neighbouring cells differ.
+TEST(AutoTable, CellsSharedByCopiesAndThreads) {
+  const rect r = xz_rect(-1.0f, 1.0f, -0.5f, 0.5f, 0.0f, true);  // facing -y
+  const vec3 c(0.0f), h1 = 0.5f * r.e1, h2 = 0.5f * r.e2;
+  const auto rule = [](const vec3& o, const vec3& n) {
+    const float f = std::sin(7.0f * o.x) + std::sin(5.0f * o.z) + std::sin(3.0f * o.y) + 2.0f * n.x + n.z;
+    return f < -0.5f ? light_sampling::area : f < 0.7f ? light_sampling::solid_angle : light_sampling::projected_solid_angle;
+  };
+  const planar_auto_table serial(c, h1, h2, r.n, rule), shared(c, h1, h2, r.n, rule);
+  std::vector<vec3> os, ns;
+  pcg32 rng(11, 4);
+  for (int i = 0; i < 40000; ++i) {
+    os.emplace_back(6.0f * rng.uniform() - 3.0f, -3.0f * rng.uniform() - 1e-3f, 4.0f * rng.uniform() - 2.0f);
+    ns.push_back(glm::normalize(vec3(2 * rng.uniform() - 1, 2 * rng.uniform() - 1, 2 * rng.uniform() - 1)));
+  }
+  std::vector<light_sampling> expected(os.size()), got_a(os.size()), got_b(os.size());
+  for (std::size_t i = 0; i < os.size(); ++i) expected[i] = serial.lookup(os[i], ns[i]);
+  {
+    const planar_auto_table copy = shared;  // shares the cells
+    std::jthread a([&] { for (std::size_t i = 0; i < os.size(); ++i) got_a[i] = shared.lookup(os[i], ns[i]); });
+    std::jthread b([&] { for (std::size_t i = os.size(); i-- > 0;) got_b[i] = copy.lookup(os[i], ns[i]); });
+  }
+  std::array<int, 3> seen{};
+  for (std::size_t i = 0; i < os.size(); ++i) {
+    ASSERT_EQ(got_a[i], expected[i]) << "receiver " << i;
+    ASSERT_EQ(got_b[i], expected[i]) << "receiver " << i;
+    ++seen[static_cast<int>(expected[i])];
+  }
+  for (const int k : seen) EXPECT_GT(k, 1000) << "every choice is met";
+}
+
+// A lookup in front of the light answers the rule's one choice; behind it
+// area (as every table). A far small light in an image with any noise:
+// area.
+TEST(AutoTable, OneChoiceInFrontAreaBehind) {
   const rect r = xz_rect(-1.0f, 1.0f, -0.5f, 0.5f, 0.0f, true);  // facing -y
   const planar_auto_table table(vec3(0.0f), 0.5f * r.e1, 0.5f * r.e2, r.n,
                                 [](const vec3&, const vec3&) { return light_sampling::solid_angle; });
-  EXPECT_TRUE(table.uniform());
   EXPECT_EQ(table.lookup(vec3(0.3f, -2.0f, 0.1f), vec3(0, 1, 0)), light_sampling::solid_angle);
   EXPECT_EQ(table.lookup(vec3(0.3f, 2.0f, 0.1f), vec3(0, 1, 0)), light_sampling::area);
-  // A far small light in an image with any noise: every cell area.
   auto_params p;
   p.image_variance = 1.0f;
   const rect tiny = xz_rect(-1e-3f, 1e-3f, -1e-3f, 1e-3f, 0.0f, true);

@@ -326,7 +326,9 @@ TEST_F(Cli, PerLightSamplingField) {
 }
 
 // `auto` measures the image's noise by a pilot unless --auto-rest-variance
-// fixes v_rest; the stats say so, and its time is part of render_seconds.
+// fixes v_rest; the stats say so, and its time is part of render_seconds,
+// as is the set-up of the lights `auto` samples (auto_setup_seconds, with
+// and without the pilot; absent where no light is sampled by `auto`).
 TEST_F(Cli, AutoNoisePilotInStats) {
   const std::string floor = R"({"type": "xz_rect", "x0": -5, "x1": 5, "z0": -5, "z1": 5, "k": 0, "material": "white"})";
   const std::string lamp = R"({"type": "xz_rect", "x0": -0.5, "x1": 0.5, "z0": -0.5, "z1": 0.5, "k": 2, "material": "light", "flip": true})";
@@ -340,11 +342,17 @@ TEST_F(Cli, AutoNoisePilotInStats) {
   ASSERT_TRUE(j.contains("auto_albedo"));
   EXPECT_NEAR(j["auto_albedo"].get<double>(), 0.7, 1e-6);  // scene_with's white floor
   EXPECT_GT(j["auto_image_variance"].get<double>(), 0.0);
-  EXPECT_LE(j["auto_pilot_seconds"].get<double>(), j["render_seconds"].get<double>());
+  ASSERT_TRUE(j.contains("auto_setup_seconds"));
+  EXPECT_GT(j["auto_setup_seconds"].get<double>(), 0.0);
+  EXPECT_LE(j["auto_pilot_seconds"].get<double>() + j["auto_setup_seconds"].get<double>(),
+            j["render_seconds"].get<double>());
   for (const char* flags : {"--light-sampling auto --auto-rest-variance 4", "--light-sampling area", ""}) {
     ASSERT_EQ(run(base + flags).status, 0) << flags;
     j = nlohmann::json::parse(slurp(stats));
     EXPECT_FALSE(j.contains("auto_pilot_seconds")) << flags;
+    const bool is_auto = std::string(flags).find("auto") != std::string::npos;
+    EXPECT_EQ(j.contains("auto_setup_seconds"), is_auto) << flags;
+    if (is_auto) EXPECT_LE(j["auto_setup_seconds"].get<double>(), j["render_seconds"].get<double>()) << flags;
   }
   expect_bad("render " + s.string() + " -o " + out.string() + " --light-sampling auto --auto-rest-variance 0",
              {"--auto-rest-variance"}, out);

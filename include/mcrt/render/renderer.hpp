@@ -12,8 +12,10 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -102,6 +104,11 @@ render_result render_with(const Scene& sc, const camera& cam, const render_setti
   out.threads = n;
 
   std::atomic<int> next{0}, done{0};
+  // The progress reporter waits on this between reports, and the tile that
+  // completes the image wakes it: the image's time is not rounded up to
+  // the progress interval.
+  std::mutex finished_mutex;
+  std::condition_variable finished;
   std::atomic<std::uint64_t> nonfinite{0};
   auto worker = [&] {
     std::uint64_t bad = 0;
@@ -110,7 +117,10 @@ render_result render_with(const Scene& sc, const camera& cam, const render_setti
       const int x1 = std::min(x0 + tile, rs.width), y1 = std::min(y0 + tile, rs.height);
       for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) out.img.at(x, y) = render_pixel<Integrator>(sc, cam, rs, sampler, x, y, bad);
-      done.fetch_add(1, std::memory_order_release);
+      if (done.fetch_add(1, std::memory_order_release) + 1 == tile_count) {
+        const std::lock_guard<std::mutex> lock(finished_mutex);
+        finished.notify_all();
+      }
     }
     nonfinite.fetch_add(bad, std::memory_order_relaxed);
   };
@@ -125,7 +135,9 @@ render_result render_with(const Scene& sc, const camera& cam, const render_setti
     pool.emplace_back(worker);
     for (int d; (d = done.load(std::memory_order_acquire)) < tile_count;) {
       progress(static_cast<double>(d) / tile_count, elapsed());
-      std::this_thread::sleep_for(progress_interval);
+      std::unique_lock<std::mutex> lock(finished_mutex);
+      finished.wait_for(lock, progress_interval,
+                        [&] { return done.load(std::memory_order_acquire) == tile_count; });
     }
   } else {
     worker();

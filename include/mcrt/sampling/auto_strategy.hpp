@@ -44,7 +44,8 @@
 // auto_choice::v_area). auto_sampler evaluates the rule of a light once
 // per cell of a table of receiver positions and normals (auto_table.hpp;
 // for a sphere, of distances and normals' angles to its centre), so a
-// shading point pays a lookup, not the rule.
+// shading point pays a lookup, not the rule (and each cell the rule once,
+// when a receiver first falls in it).
 #include <algorithm>
 #include <limits>
 #if defined(__SSE2__)
@@ -524,7 +525,7 @@ class tabulated_planar_rule {
  private:
   tabulated_planar_rule(const planar_rule& rule, const vec3& c, const vec3& h1, const vec3& h2, const vec3& nl,
                         const auto_params& p)
-      : table_(c, h1, h2, nl, [&](const vec3& o, const vec3& n) { return rule.choose(o, n, p); }) {}
+      : table_(c, h1, h2, nl, [rule, p](const vec3& o, const vec3& n) { return rule.choose(o, n, p); }) {}
   planar_auto_table table_;
 };
 // Spheres: the rule, tabulated over the receiver's distance and the
@@ -532,7 +533,7 @@ class tabulated_planar_rule {
 class tabulated_sphere_rule {
  public:
   tabulated_sphere_rule(const sphere& s, const auto_params& p)
-      : table_(s.center, s.radius, [&](const vec3& o, const vec3& n) { return choose_strategy(s, o, n, p); }) {}
+      : table_(s.center, s.radius, [s, p](const vec3& o, const vec3& n) { return choose_strategy(s, o, n, p); }) {}
   light_sampling choose(const vec3& o, const vec3& n) const { return table_.lookup(o, n); }
 
  private:

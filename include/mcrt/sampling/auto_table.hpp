@@ -6,8 +6,8 @@
 // around the light is cut into cells of the receiver's position (in the
 // light's frame: two lateral coordinates and the height over its plane) and
 // of its normal (octahedral map in the light's frame), and each cell holds
-// the rule's choice at the cell's centre, computed once, when the light is
-// made. The choice is thus a function of (light, o, n) alone, piecewise
+// the rule's choice at the cell's centre, computed once, when a lookup
+// first meets the cell (lazy_choice_cells). The choice is thus a function of (light, o, n) alone, piecewise
 // constant, so sample(), pdf() and the true density agree as for every
 // strategy; only where a cell straddles the rule's boundary does a point
 // get its neighbour's choice.
@@ -25,10 +25,11 @@
 // vectors", EGSR) of n in the light's frame onto [-1, 1]^2.
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <memory>
-#include <vector>
 
 #include "mcrt/core/fast_math.hpp"
 #include "mcrt/core/math.hpp"
@@ -36,27 +37,49 @@
 
 namespace mcrt {
 
-// The cells of a tabulated choice (one byte each, a light_sampling), shared
-// by the copies of a light, and whether they all hold one choice (then a
-// lookup needs no cell).
-class choice_cells {
+// The cells of a tabulated choice, each holding the rule's choice at the
+// cell's centre, evaluated when a lookup first meets the cell: a scene
+// pays for the cells its receivers fall in (a few thousand in a room, of
+// the table's million), not for the whole table, which took ~0.1 s per
+// light to fill. A cell's byte is 0 until evaluated, then 1 + the choice.
+// The choice is a pure function of the cell, so threads that meet a cell
+// at once compute and store the same byte: relaxed atomics suffice, and
+// an image does not depend on which thread met a cell first. Shared by the
+// copies of a light.
+class lazy_choice_cells {
  public:
-  choice_cells() = default;
-  explicit choice_cells(std::vector<std::uint8_t> cells)
-      : cells_(std::make_shared<const std::vector<std::uint8_t>>(std::move(cells))) {
-    const std::uint8_t first = cells_->front();
-    uniform_ = std::all_of(cells_->begin(), cells_->end(), [&](std::uint8_t c) { return c == first; });
-    uniform_choice_ = static_cast<light_sampling>(first);
+  // The rule's choice at the centre of cell i.
+  using fill_fn = std::function<light_sampling(std::size_t)>;
+
+  lazy_choice_cells() = default;
+  lazy_choice_cells(std::size_t count, fill_fn fill) : s_(std::make_shared<state>(count, std::move(fill))) {}
+
+  light_sampling operator[](std::size_t i) const {
+    std::atomic<std::uint8_t>& cell = s_->cells[i];
+    std::uint8_t v = cell.load(std::memory_order_relaxed);
+    if (v == 0) [[unlikely]] {
+      v = static_cast<std::uint8_t>(1 + static_cast<int>(s_->fill(i)));
+      cell.store(v, std::memory_order_relaxed);
+    }
+    return static_cast<light_sampling>(v - 1);
   }
 
-  bool uniform() const { return uniform_; }
-  light_sampling uniform_choice() const { return uniform_choice_; }
-  light_sampling operator[](std::size_t i) const { return static_cast<light_sampling>((*cells_)[i]); }
+  // How many cells have been evaluated so far.
+  std::size_t evaluated() const {
+    if (!s_) return 0;
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < s_->count; ++i) k += s_->cells[i].load(std::memory_order_relaxed) != 0;
+    return k;
+  }
 
  private:
-  std::shared_ptr<const std::vector<std::uint8_t>> cells_;
-  bool uniform_ = false;
-  light_sampling uniform_choice_ = light_sampling::area;
+  struct state {
+    state(std::size_t n, fill_fn f) : count(n), cells(new std::atomic<std::uint8_t>[n]()), fill(std::move(f)) {}
+    std::size_t count;
+    std::unique_ptr<std::atomic<std::uint8_t>[]> cells;  // value-initialised: 0, not yet evaluated
+    fill_fn fill;
+  };
+  std::shared_ptr<state> s_;
 };
 
 class planar_auto_table {
@@ -70,60 +93,21 @@ class planar_auto_table {
   planar_auto_table() = default;
 
   // centre, the two half-extent vectors (orthogonal) and the unit normal of
-  // the light's front; choose(o, n) the rule to tabulate.
+  // the light's front; choose(o, n) the rule to tabulate (kept by the
+  // table, which evaluates it at a cell's centre when a lookup first meets
+  // the cell).
   template <class Rule>
-  planar_auto_table(const vec3& centre, const vec3& half1, const vec3& half2, const vec3& normal, const Rule& choose)
+  planar_auto_table(const vec3& centre, const vec3& half1, const vec3& half2, const vec3& normal, Rule choose)
       : c_(centre), nl_(normal) {
     s1_ = glm::length(half1);
     s2_ = glm::length(half2);
     u1_ = half1 / s1_;
     u2_ = half2 / s2_;
     sh_ = std::sqrt(s1_ * s2_);
-    std::vector<std::uint8_t> cells(cell_count);
-    // The last cell of each position coordinate that holds another choice
-    // than area (for the box of area_beyond_ below).
-    int last[3] = {-1, -1, -1};
-    for (int ix = 0; ix < lateral_cells; ++ix)
-      for (int iy = 0; iy < lateral_cells; ++iy)
-        for (int ih = 0; ih < height_cells; ++ih) {
-          const float x = expand(centre_of(ix, lateral_cells, 0.0f, 1.0f), s1_);
-          const float y = expand(centre_of(iy, lateral_cells, 0.0f, 1.0f), s2_);
-          const float h = expand(centre_of(ih, height_cells, 0.0f, 1.0f), sh_);
-          const vec3 o = c_ + x * u1_ + y * u2_ + h * nl_;
-          for (int a = 0; a < normal_cells; ++a)
-            for (int b = 0; b < normal_cells; ++b) {
-              const vec3 nloc = octahedral_decode(centre_of(a, normal_cells, -1.0f, 1.0f),
-                                                  centre_of(b, normal_cells, -1.0f, 1.0f));
-              const vec3 n = glm::normalize(nloc.x * u1_ + nloc.y * u2_ + nloc.z * nl_);
-              const light_sampling c = choose(o, n);
-              cells[index(ix, iy, ih, a, b)] = static_cast<std::uint8_t>(c);
-              if (c != light_sampling::area)
-                last[0] = std::max(last[0], ix), last[1] = std::max(last[1], iy), last[2] = std::max(last[2], ih);
-            }
-        }
-    // One choice in every cell (a light far from everything the image
-    // holds, or an image whose noise is all elsewhere): no lookup needed.
-    cells_ = choice_cells(std::move(cells));
-    // The box (in the light's frame) outside which every cell holds area
-    // sampling: the cells' upper ends, expanded, past the last cell of each
-    // coordinate that holds another choice. Outside it a lookup needs the
-    // receiver's position alone, not its normal or cell (most receivers,
-    // when the dearer strategies pay only close to the light).
-    auto upper_end = [](int last_cell, int k, float scale) {
-      // Cell i covers t in [i / k, (i + 1) / k); the last cell reaches infinity.
-      return last_cell + 1 >= k ? infinity : expand(float(last_cell + 1) / float(k), scale);
-    };
-    area_beyond_ = {upper_end(last[0], lateral_cells, s1_), upper_end(last[1], lateral_cells, s2_),
-                    upper_end(last[2], height_cells, sh_)};
+    cells_ = lazy_choice_cells(cell_count, [frame = *this, choose = std::move(choose)](std::size_t i) {
+      return choose(frame.cell_receiver(i), frame.cell_normal(i));
+    });
   }
-
-  // Whether every cell holds the same choice (then lookup() is that choice
-  // in front of the light, without the cell's computation).
-  bool uniform() const { return cells_.uniform(); }
-
-  // The box beyond which every receiver gets area sampling: |x|, |y| and h
-  // (light's frame) from which on no cell holds another choice.
-  const std::array<float, 3>& area_beyond() const { return area_beyond_; }
 
   // The tabulated choice at o for the unit normal n; area where o is not
   // in front of the light (h <= 0: nothing is sampled there).
@@ -131,11 +115,9 @@ class planar_auto_table {
     const vec3 d = o - c_;
     const float h = glm::dot(d, nl_);
     if (!(h > 0.0f)) return light_sampling::area;
-    if (cells_.uniform()) return cells_.uniform_choice();
     const float x0 = glm::dot(d, u1_), y0 = glm::dot(d, u2_);
     // Reflected into the quadrant x, y >= 0, n with it.
     const float x = std::abs(x0), y = std::abs(y0);
-    if (x >= area_beyond_[0] || y >= area_beyond_[1] || h >= area_beyond_[2]) return light_sampling::area;
     const float nx = std::copysign(1.0f, x0) * glm::dot(n, u1_), ny = std::copysign(1.0f, y0) * glm::dot(n, u2_);
     const float nz = glm::dot(n, nl_);
     // The four divisions as one packed one.
@@ -158,6 +140,23 @@ class planar_auto_table {
   static std::size_t index(int ix, int iy, int ih, int a, int b) {
     return (((std::size_t(ix) * lateral_cells + iy) * height_cells + ih) * normal_cells + a) * normal_cells + b;
   }
+  // The centre of cell i: its receiver (light's frame: the quadrant x, y >=
+  // 0 in front of the light) and its unit normal.
+  vec3 cell_receiver(std::size_t i) const {
+    const std::size_t position = i / (std::size_t(normal_cells) * normal_cells);
+    const int ih = int(position % height_cells), iy = int(position / height_cells % lateral_cells),
+              ix = int(position / (std::size_t(height_cells) * lateral_cells));
+    const float x = expand(centre_of(ix, lateral_cells, 0.0f, 1.0f), s1_);
+    const float y = expand(centre_of(iy, lateral_cells, 0.0f, 1.0f), s2_);
+    const float h = expand(centre_of(ih, height_cells, 0.0f, 1.0f), sh_);
+    return c_ + x * u1_ + y * u2_ + h * nl_;
+  }
+  vec3 cell_normal(std::size_t i) const {
+    const int b = int(i % normal_cells), a = int(i / normal_cells % normal_cells);
+    const vec3 nloc =
+        octahedral_decode(centre_of(a, normal_cells, -1.0f, 1.0f), centre_of(b, normal_cells, -1.0f, 1.0f));
+    return glm::normalize(nloc.x * u1_ + nloc.y * u2_ + nloc.z * nl_);
+  }
   // The cell of t in [lo, hi) cut into k (NaN and the ends clamped).
   static int cell(float t, int k, float lo, float hi) {
     const float f = (t - lo) / (hi - lo) * float(k);
@@ -174,8 +173,7 @@ class planar_auto_table {
 
   vec3 c_{0.0f}, u1_{1, 0, 0}, u2_{0, 1, 0}, nl_{0, 0, 1};
   float s1_ = 1.0f, s2_ = 1.0f, sh_ = 1.0f;
-  choice_cells cells_;
-  std::array<float, 3> area_beyond_{0.0f, 0.0f, 0.0f};  // x, y, h beyond which every cell holds area
+  lazy_choice_cells cells_;
 };
 
 // The `auto` choice of a sphere, tabulated. By the sphere's symmetry the
@@ -187,31 +185,31 @@ class planar_auto_table {
 // error). Cells are uniform in t, fine near the sphere where the choice
 // changes, and in the cosine; each holds the rule's choice at its centre.
 // Receivers inside the sphere (t >= 1: nothing of it is seen lit) get area
-// sampling. 64 KB per sphere light; the lookup is a division and a square
-// root where the rule (auto_strategy.hpp) takes tens of ns off the horizon.
+// sampling. 64 KB per sphere light, filled as receivers meet its cells;
+// the lookup is a division and a square root where the rule
+// (auto_strategy.hpp) takes tens of ns off the horizon.
 class sphere_auto_table {
  public:
   static constexpr int distance_cells = 256, cosine_cells = 256;
 
   sphere_auto_table() = default;
 
-  // The sphere's centre and radius; choose(o, n) the rule to tabulate.
+  // The sphere's centre and radius; choose(o, n) the rule to tabulate (kept
+  // by the table and evaluated at a cell's centre when a lookup first
+  // meets the cell).
   template <class Rule>
-  sphere_auto_table(const vec3& centre, float radius, const Rule& choose) : c_(centre), r2_(radius * radius) {
-    std::vector<std::uint8_t> cells(std::size_t(distance_cells) * cosine_cells);
-    for (int i = 0; i < distance_cells; ++i) {
-      const float t = (float(i) + 0.5f) / float(distance_cells);
-      const vec3 o = centre + vec3(radius / std::sqrt(t), 0.0f, 0.0f);  // the centre is along -x from o
-      for (int j = 0; j < cosine_cells; ++j) {
-        const float cs = -1.0f + 2.0f * (float(j) + 0.5f) / float(cosine_cells);
-        const vec3 n(-cs, std::sqrt(std::max(1.0f - cs * cs, 0.0f)), 0.0f);
-        cells[std::size_t(i) * cosine_cells + j] = static_cast<std::uint8_t>(choose(o, n));
-      }
-    }
-    cells_ = choice_cells(std::move(cells));
+  sphere_auto_table(const vec3& centre, float radius, Rule choose) : c_(centre), r2_(radius * radius) {
+    cells_ = lazy_choice_cells(std::size_t(distance_cells) * cosine_cells,
+                               [centre, radius, choose = std::move(choose)](std::size_t k) {
+                                 const int i = int(k / cosine_cells), j = int(k % cosine_cells);
+                                 const float t = (float(i) + 0.5f) / float(distance_cells);
+                                 // The centre is along -x from o, n at the cell's cosine to it.
+                                 const vec3 o = centre + vec3(radius / std::sqrt(t), 0.0f, 0.0f);
+                                 const float cs = -1.0f + 2.0f * (float(j) + 0.5f) / float(cosine_cells);
+                                 const vec3 n(-cs, std::sqrt(std::max(1.0f - cs * cs, 0.0f)), 0.0f);
+                                 return choose(o, n);
+                               });
   }
-
-  bool uniform() const { return cells_.uniform(); }
 
   // The tabulated choice at o for the normal n (of any length); area inside
   // the sphere.
@@ -220,7 +218,6 @@ class sphere_auto_table {
     const float d2 = glm::dot(v, v);
     const float t = r2_ / d2;
     if (!(t < 1.0f)) return light_sampling::area;
-    if (cells_.uniform()) return cells_.uniform_choice();
     const float cs = glm::dot(v, n) / std::sqrt(d2 * glm::dot(n, n));
     const int i = std::min(int(t * float(distance_cells)), distance_cells - 1);
     const float f = (cs + 1.0f) * (0.5f * float(cosine_cells));
@@ -231,7 +228,7 @@ class sphere_auto_table {
  private:
   vec3 c_{0.0f};
   float r2_ = 1.0f;
-  choice_cells cells_;
+  lazy_choice_cells cells_;
 };
 
 }  // namespace mcrt
