@@ -28,8 +28,10 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <functional>
 #include <memory>
+#include <new>
 
 #include "mcrt/core/fast_math.hpp"
 #include "mcrt/core/math.hpp"
@@ -55,7 +57,7 @@ class lazy_choice_cells {
   lazy_choice_cells(std::size_t count, fill_fn fill) : s_(std::make_shared<state>(count, std::move(fill))) {}
 
   light_sampling operator[](std::size_t i) const {
-    std::atomic<std::uint8_t>& cell = s_->cells[i];
+    const std::atomic_ref<std::uint8_t> cell(s_->cells[i]);
     std::uint8_t v = cell.load(std::memory_order_relaxed);
     if (v == 0) [[unlikely]] {
       v = static_cast<std::uint8_t>(1 + static_cast<int>(s_->fill(i)));
@@ -68,15 +70,25 @@ class lazy_choice_cells {
   std::size_t evaluated() const {
     if (!s_) return 0;
     std::size_t k = 0;
-    for (std::size_t i = 0; i < s_->count; ++i) k += s_->cells[i].load(std::memory_order_relaxed) != 0;
+    for (std::size_t i = 0; i < s_->count; ++i)
+      k += std::atomic_ref<std::uint8_t>(s_->cells[i]).load(std::memory_order_relaxed) != 0;
     return k;
   }
 
  private:
+  struct free_bytes {
+    void operator()(std::uint8_t* p) const { std::free(p); }
+  };
   struct state {
-    state(std::size_t n, fill_fn f) : count(n), cells(new std::atomic<std::uint8_t>[n]()), fill(std::move(f)) {}
+    // calloc: zeroed memory whose pages the system maps (zero-filled) when
+    // first touched, so a table costs the pages its met cells lie in, not
+    // the megabyte of a planar light's table.
+    state(std::size_t n, fill_fn f)
+        : count(n), cells(static_cast<std::uint8_t*>(std::calloc(n, 1))), fill(std::move(f)) {
+      if (!cells) throw std::bad_alloc();
+    }
     std::size_t count;
-    std::unique_ptr<std::atomic<std::uint8_t>[]> cells;  // value-initialised: 0, not yet evaluated
+    std::unique_ptr<std::uint8_t[], free_bytes> cells;  // 0: not yet evaluated
     fill_fn fill;
   };
   std::shared_ptr<state> s_;
@@ -137,13 +149,17 @@ class planar_auto_table {
   }
 
  private:
+  // The normal's cells outermost: the receivers of one wall (one normal)
+  // meet the cells of one 4 KB block, a few pages per room (position
+  // cells: 16 x 16 x 16 bytes).
+  static constexpr std::size_t position_cells = std::size_t(lateral_cells) * lateral_cells * height_cells;
   static std::size_t index(int ix, int iy, int ih, int a, int b) {
-    return (((std::size_t(ix) * lateral_cells + iy) * height_cells + ih) * normal_cells + a) * normal_cells + b;
+    return (std::size_t(a) * normal_cells + b) * position_cells + (std::size_t(ix) * lateral_cells + iy) * height_cells + ih;
   }
   // The centre of cell i: its receiver (light's frame: the quadrant x, y >=
   // 0 in front of the light) and its unit normal.
   vec3 cell_receiver(std::size_t i) const {
-    const std::size_t position = i / (std::size_t(normal_cells) * normal_cells);
+    const std::size_t position = i % position_cells;
     const int ih = int(position % height_cells), iy = int(position / height_cells % lateral_cells),
               ix = int(position / (std::size_t(height_cells) * lateral_cells));
     const float x = expand(centre_of(ix, lateral_cells, 0.0f, 1.0f), s1_);
@@ -152,7 +168,8 @@ class planar_auto_table {
     return c_ + x * u1_ + y * u2_ + h * nl_;
   }
   vec3 cell_normal(std::size_t i) const {
-    const int b = int(i % normal_cells), a = int(i / normal_cells % normal_cells);
+    const std::size_t normal = i / position_cells;
+    const int b = int(normal % normal_cells), a = int(normal / normal_cells);
     const vec3 nloc =
         octahedral_decode(centre_of(a, normal_cells, -1.0f, 1.0f), centre_of(b, normal_cells, -1.0f, 1.0f));
     return glm::normalize(nloc.x * u1_ + nloc.y * u2_ + nloc.z * nl_);
