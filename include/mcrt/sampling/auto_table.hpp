@@ -7,10 +7,10 @@
 // light's frame: two lateral coordinates and the height over its plane) and
 // of its normal (octahedral map in the light's frame), and each cell holds
 // the rule's choice at the cell's centre, computed once, when a lookup
-// first meets the cell (lazy_choice_cells). The choice is thus a function of (light, o, n) alone, piecewise
-// constant, so sample(), pdf() and the true density agree as for every
-// strategy; only where a cell straddles the rule's boundary does a point
-// get its neighbour's choice.
+// first meets the cell (lazy_choice_cells). The choice is thus a function
+// of (light, o, n) alone, piecewise constant, so sample(), pdf() and the
+// true density agree as for every strategy; only where a cell straddles
+// the rule's boundary does a point get its neighbour's choice.
 //
 // Coordinates: the light and the rule are symmetric under x -> -x (with n's
 // x component) and y -> -y along its two axes, so the table holds the
@@ -42,8 +42,8 @@ namespace mcrt {
 // The cells of a tabulated choice, each holding the rule's choice at the
 // cell's centre, evaluated when a lookup first meets the cell: a scene
 // pays for the cells its receivers fall in (a few thousand in a room, of
-// the table's million), not for the whole table, which took ~0.1 s per
-// light to fill. A cell's byte is 0 until evaluated, then 1 + the choice.
+// the table's million), not for the whole table (~0.1 s per planar light
+// to fill). A cell's byte is 0 until evaluated, then 1 + the choice.
 // The choice is a pure function of the cell, so threads that meet a cell
 // at once compute and store the same byte: relaxed atomics suffice, and
 // an image does not depend on which thread met a cell first. Shared by the
@@ -66,15 +66,6 @@ class lazy_choice_cells {
     return static_cast<light_sampling>(v - 1);
   }
 
-  // How many cells have been evaluated so far.
-  std::size_t evaluated() const {
-    if (!s_) return 0;
-    std::size_t k = 0;
-    for (std::size_t i = 0; i < s_->count; ++i)
-      k += std::atomic_ref<std::uint8_t>(s_->cells[i]).load(std::memory_order_relaxed) != 0;
-    return k;
-  }
-
  private:
   struct free_bytes {
     void operator()(std::uint8_t* p) const { std::free(p); }
@@ -83,11 +74,9 @@ class lazy_choice_cells {
     // calloc: zeroed memory whose pages the system maps (zero-filled) when
     // first touched, so a table costs the pages its met cells lie in, not
     // the megabyte of a planar light's table.
-    state(std::size_t n, fill_fn f)
-        : count(n), cells(static_cast<std::uint8_t*>(std::calloc(n, 1))), fill(std::move(f)) {
+    state(std::size_t n, fill_fn f) : cells(static_cast<std::uint8_t*>(std::calloc(n, 1))), fill(std::move(f)) {
       if (!cells) throw std::bad_alloc();
     }
-    std::size_t count;
     std::unique_ptr<std::uint8_t[], free_bytes> cells;  // 0: not yet evaluated
     fill_fn fill;
   };
