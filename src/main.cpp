@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <limits>
@@ -45,10 +46,13 @@ void check_range(const std::optional<int>& v, const char* flag, int lo, int hi) 
 // light_sampling), "mixed" or "none". Only emitters count: book 3's glass
 // sphere ("sample": true, emits nothing) is an importance target of the
 // mixture, not a light.
-std::string strategy_summary(const scene& world) {
+std::string strategy_summary(const loaded_scene& ls) {
+  const scene& world = ls.world;
   std::optional<light_sampling> first;
   for (const emitter& e : world.emitters) {
-    const light_sampling s = strategy_of(world.lights[e.light]);
+    // A light `auto` found best sampled by its cheapest strategy is still auto's.
+    const bool cheapest = std::ranges::find(ls.auto_cheapest_lights, e.light) != ls.auto_cheapest_lights.end();
+    const light_sampling s = cheapest ? light_sampling::automatic : strategy_of(world.lights[e.light]);
     if (first && *first != s) return "mixed";
     first = s;
   }
@@ -117,7 +121,7 @@ int run_render(const render_options& opt) {
     // A noise-free pilot leaves nothing for a cheaper strategy to hide in.
     ap.image_variance = std::max(static_cast<float>(noise->image_variance), std::numeric_limits<float>::min());
     ap.albedo = static_cast<float>(std::sqrt(noise->mean_albedo2));
-    ls = load_scene(opt.scene, strategy, map, ap);
+    ls = load_scene(opt.scene, strategy, map, ap, false, noise->receivers);
   }
 
   render_result res = render_scene(ls.world, cam, rs, opt.quiet ? progress_callback{} : progress_callback(print_progress));
@@ -125,7 +129,7 @@ int run_render(const render_options& opt) {
   if (noise) res.seconds += noise->seconds;
   res.seconds += ls.auto_setup_seconds;
   const double samples = static_cast<double>(rs.width) * rs.height * rs.spp;
-  const std::string strategy_used = strategy_summary(ls.world);
+  const std::string strategy_used = strategy_summary(ls);
   if (res.nonfinite_samples && !opt.quiet)
     std::fprintf(stderr, "mcrt: %llu non-finite radiance samples were dropped\n",
                  static_cast<unsigned long long>(res.nonfinite_samples));
@@ -159,6 +163,7 @@ int run_render(const render_options& opt) {
     j["scene"] = ls.name;
     j["nonfinite_samples"] = res.nonfinite_samples;
     if (ls.auto_lights > 0) j["auto_setup_seconds"] = ls.auto_setup_seconds;
+    if (noise) j["auto_cheapest_lights"] = ls.auto_cheapest_lights.size();
     if (noise) {
       j["auto_pilot_seconds"] = noise->seconds;
       j["auto_image_variance"] = noise->image_variance;

@@ -7,7 +7,9 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <span>
 #include <sstream>
+#include <variant>
 
 namespace mcrt::cli {
 namespace {
@@ -258,7 +260,7 @@ constexpr const char* strategy_names = "area, solid-angle, projected-solid-angle
 void read_object(const reader& rd, const json& o, const std::string& path, scene& world,
                  const std::map<std::string, std::uint32_t>& material_ids,
                  std::optional<light_sampling> override_strategy, ellipse_map map, const auto_params& ap,
-                 bool auto_pilot, int& auto_lights, double& auto_setup_seconds) {
+                 bool auto_pilot, std::span<const auto_receiver> auto_receivers, loaded_scene& out) {
   if (!o.is_object()) rd.ctx.fail(path, std::string("expected an object, got ") + type_name(o));
   std::string type = rd.string(o, path, "type");
   const std::string mat_name = rd.string(o, path, "material");
@@ -300,7 +302,7 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
       return;
     }
     if (strategy == light_sampling::automatic && is_light) {
-      ++auto_lights;
+      ++out.auto_lights;
       // The noise pilot's scene: the shape's default strategy (its cheapest).
       if (auto_pilot) {
         add_light(world, shape, mat, std::nullopt, map, ap);
@@ -314,7 +316,28 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
       // evaluated) is part of the image's time (loaded_scene).
       const auto start = std::chrono::steady_clock::now();
       add_light(world, shape, mat, strategy, map, lp);
-      auto_setup_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      // Where its choice does not pay for its own cost at the pilot's
+      // receivers, the light takes its cheapest strategy's sampler, with no
+      // choice per light sample (auto_sampler::table_gain).
+      if (!auto_receivers.empty()) {
+        std::optional<light> cheapest;
+        std::visit(
+            [&]<class S>(const S& l) {
+              if constexpr (strategy_of<S>() == light_sampling::automatic)
+                if (!(l.table_gain(auto_receivers) > 0.0f)) {
+                  if (l.cheapest() == light_sampling::area)
+                    cheapest = l.area;
+                  else
+                    cheapest = l.solid_angle;
+                }
+            },
+            world.lights.back());
+        if (cheapest) {
+          world.lights.back() = std::move(*cheapest);
+          out.auto_cheapest_lights.push_back(static_cast<std::uint32_t>(world.lights.size() - 1));
+        }
+      }
+      out.auto_setup_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       return;
     }
     add_light(world, shape, mat, strategy, map, ap);
@@ -369,7 +392,7 @@ std::optional<light_sampling> parse_light_sampling_flag(const std::string& value
 }
 
 loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy, ellipse_map map,
-                        const auto_params& ap, bool auto_pilot) {
+                        const auto_params& ap, bool auto_pilot, std::span<const auto_receiver> auto_receivers) {
   const context ctx{path};
   const reader rd{ctx};
   std::ifstream in(path, std::ios::binary);
@@ -422,7 +445,7 @@ loaded_scene load_scene(const std::string& path, std::optional<light_sampling> o
   if (objs.empty()) ctx.fail("objects", "the scene has no objects");
   for (std::size_t i = 0; i < objs.size(); ++i)
     read_object(rd, objs[i], "objects[" + std::to_string(i) + "]", out.world, ids, override_strategy, map, ap, auto_pilot,
-                out.auto_lights, out.auto_setup_seconds);
+                auto_receivers, out);
 
   // Self-intersection guard proportional to the scene's coordinates: a few
   // thousand float ulps of the largest coordinate (1.1e-3 for the 555-unit

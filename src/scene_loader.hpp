@@ -3,8 +3,10 @@
 // Every violation of the contract throws input_error with one line naming
 // the file, the place in it and what is wrong.
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "mcrt/mcrt.hpp"
 
@@ -35,6 +37,10 @@ struct loaded_scene {
   // Time spent making those lights' samplers (seconds): `mcrt render` counts
   // it in the image's time, as it does the noise pilot.
   double auto_setup_seconds = 0.0;
+  // Of those, the lights (indices in world.lights) whose per-point choice
+  // did not pay for its cost at the noise pilot's receivers: sampled by
+  // their cheapest strategy everywhere.
+  std::vector<std::uint32_t> auto_cheapest_lights;
 };
 
 // Which area-preserving map of the spherical ellipse samples an ellipse by
@@ -54,7 +60,11 @@ std::optional<light_sampling> parse_light_sampling_flag(const std::string& value
 // each with its own light's radiance.
 // auto_pilot: the scene for that pilot: every light that would be sampled by
 // `auto` takes its shape's default (cheapest) strategy instead.
+// auto_receivers: the surfaces the noise pilot's pixels see; where given, a
+// light sampled by `auto` whose choice does not pay for its cost there
+// takes its cheapest strategy everywhere (auto_sampler::table_gain).
 loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy = std::nullopt,
-                        ellipse_map map = ellipse_map::parallel, const auto_params& ap = {}, bool auto_pilot = false);
+                        ellipse_map map = ellipse_map::parallel, const auto_params& ap = {}, bool auto_pilot = false,
+                        std::span<const auto_receiver> auto_receivers = {});
 
 }  // namespace mcrt::cli

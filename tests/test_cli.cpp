@@ -352,10 +352,51 @@ TEST_F(Cli, AutoNoisePilotInStats) {
     EXPECT_FALSE(j.contains("auto_pilot_seconds")) << flags;
     const bool is_auto = std::string(flags).find("auto") != std::string::npos;
     EXPECT_EQ(j.contains("auto_setup_seconds"), is_auto) << flags;
-    if (is_auto) EXPECT_LE(j["auto_setup_seconds"].get<double>(), j["render_seconds"].get<double>()) << flags;
+    if (is_auto) {
+      EXPECT_LE(j["auto_setup_seconds"].get<double>(), j["render_seconds"].get<double>()) << flags;
+    }
   }
   expect_bad("render " + s.string() + " -o " + out.string() + " --light-sampling auto --auto-rest-variance 0",
              {"--auto-rest-variance"}, out);
+}
+
+// `auto` weighs its choice against its own cost at the pilot's receivers:
+// a small lamp far above the floor gains nothing from a choice per light
+// sample, and is sampled by area everywhere (the image bit for bit area
+// sampling's, the stats still naming auto); a large lamp low over the
+// floor keeps its choice (an image unlike area sampling's).
+TEST_F(Cli, AutoTakesTheCheapestStrategyWhereItsChoiceDoesNotPay) {
+  const std::string floor = R"({"type": "xz_rect", "x0": -5, "x1": 5, "z0": -5, "z1": 5, "k": 0, "material": "white"})";
+  const fs::path out = dir / "o.exr", area = dir / "area.exr", stats = dir / "s.json";
+  const auto diff_mse = [&] {
+    const result r = run("diff " + out.string() + " " + area.string() + " --json");
+    EXPECT_EQ(r.status, 0) << r.err;
+    return nlohmann::json::parse(r.out)["mse"].get<double>();
+  };
+  struct lamp_case {
+    const char* lamp;
+    int cheapest;
+  };
+  for (const lamp_case c : {lamp_case{R"("x0": -0.05, "x1": 0.05, "z0": -0.05, "z1": 0.05, "k": 4)", 1},
+                            lamp_case{R"("x0": -1.5, "x1": 1.5, "z0": -1.5, "z1": 1.5, "k": 0.3)", 0}}) {
+    const std::string lamp = std::string(R"({"type": "xz_rect", )") + c.lamp + R"(, "material": "light", "flip": true})";
+    const fs::path s = write("lamp.json", scene_with(floor + ", " + lamp));
+    const std::string base = "render " + s.string() + " --spp 16 --quiet --seed 3 ";
+    ASSERT_EQ(run(base + "-o " + area.string() + " --light-sampling area").status, 0);
+    ASSERT_EQ(run(base + "-o " + out.string() + " --light-sampling auto --stats " + stats.string()).status, 0);
+    const auto j = nlohmann::json::parse(slurp(stats));
+    EXPECT_EQ(j["auto_cheapest_lights"], c.cheapest) << c.lamp;
+    EXPECT_EQ(j["light_sampling"], "auto") << c.lamp;
+    if (c.cheapest) {
+      EXPECT_EQ(diff_mse(), 0.0) << c.lamp;
+    } else {
+      EXPECT_GT(diff_mse(), 0.0) << c.lamp;
+    }
+    // With v_rest given there is no pilot, and no receivers to weigh at.
+    ASSERT_EQ(run(base + "-o " + out.string() + " --light-sampling auto --auto-rest-variance 4 --stats " +
+                  stats.string()).status, 0);
+    EXPECT_FALSE(nlohmann::json::parse(slurp(stats)).contains("auto_cheapest_lights"));
+  }
 }
 
 // mcrt samples: the CSV of the contract, to a file or to stdout; samples on

@@ -351,7 +351,9 @@ TEST(Progress, ReporterDoesNotDelayTheImage) {
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_LT(wall, 30.0);
   EXPECT_LT(with.seconds, 30.0);
-  EXPECT_GE(reports, 2);
+  // (Once at the end at least: the workers may finish every tile before
+  // the reporter's first look.)
+  EXPECT_GE(reports, 1);
   EXPECT_EQ(last_fraction, 1.0);
   EXPECT_EQ(with.img.pixels, render(sc, cam, rs).img.pixels);
 }

@@ -3,15 +3,19 @@
 // variance of one pixel sample (radiance^2, averaged over the channels),
 // the V of `auto` (sampling/auto_strategy.hpp, auto_params::image_variance).
 //
-// A pilot renders a regular subset of the image's own pixels (every
-// stride-th pixel in x and y, the stride chosen to give about `pixels` of
-// them), at the image's resolution, so that each pixel's footprint, and
-// with it the noise of edges (a light seen by the camera), is the image's;
-// each pixel takes `spp` independent samples with the scene's integrator,
-// and its variance is the unbiased sample variance of those. The mean over
-// the pixels is then an unbiased estimate of the image's mean variance per
-// sample with independent samples (quasi-random samples converge faster
-// where the integrand is smooth; the pilot does not model that). It also
+// A pilot renders a stratified subset of the image's own pixels (one pixel
+// drawn uniformly in each stride x stride block, the stride chosen to give
+// about `pixels` blocks), at the image's resolution, so that each pixel's
+// footprint, and with it the noise of edges (a light seen by the camera),
+// is the image's; each pixel takes `spp` independent samples with the
+// scene's integrator, and its variance is the unbiased sample variance of
+// those. The mean over the blocks, each weighted by its area (the last
+// row and column of blocks may be narrower), is then an unbiased estimate
+// of the image's mean variance per sample with independent samples
+// (quasi-random samples converge faster where the integrand is smooth;
+// the pilot does not model that). A fixed grid of pixels would not be:
+// where its lines fall decides which of a few thin features (a light's
+// edge in view, a shadow's) it meets, and no seed averages that out. It also
 // takes the mean squared albedo of the diffuse surfaces the pixels' centres
 // see (the channels' mean): the light's contribution to a pixel is the
 // surface's albedo times a white surface's, which `auto` takes on average.
@@ -26,7 +30,20 @@
 // comes from E is taken out and put back as measured by K more camera rays
 // (hit tests only) uniform in the pixel. Each term is an unbiased sample
 // variance of uniform pixel positions, so the sum stays unbiased for the
-// variance of X, with far less spread.
+// variance of X, with far less spread. The pixels on an emitter's edge are
+// few (a line of them) and carry most of the image's variance where the
+// camera sees a light (with a fixed grid of every stride-th pixel, V
+// differed 1000-fold between the 400- and the 1024-pixel pilots of the
+// Cornell box with the seed's light), so the term s2_K(E) is measured on
+// blocks of half the stride (rounded up), four times as many pixels, with
+// the same number of rays in all (K pixels / pixels_E per pixel, at least
+// 2): V is the mean of s2(X) - s2(E) over the pilot's blocks plus the mean
+// of s2_K(E) over the finer blocks.
+//
+// The diffuse surfaces the pixels' centres see are kept too (in pixel
+// order, whichever thread met them), as the receivers at which `auto`
+// weighs what its per-point choice gains against what it costs
+// (auto_sampler::table_gain).
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -38,6 +55,7 @@
 
 #include "mcrt/render/camera.hpp"
 #include "mcrt/render/renderer.hpp"
+#include "mcrt/sampling/auto_strategy.hpp"
 #include "mcrt/samplers/independent.hpp"
 
 namespace mcrt {
@@ -80,10 +98,11 @@ struct noise_pilot_result {
   double seconds = 0.0;         // wall-clock time of the pilot
   int pixels = 0;               // pixels measured
   int stride = 1;
+  std::vector<auto_receiver> receivers;  // the diffuse surfaces the measured pixels' centres see
 };
 
-// Every stride-th pixel in each direction, stride = floor(sqrt(W H / pixels))
-// (at least 1), starting half a stride in.
+// The side of the pilot's blocks (one pixel measured in each), stride =
+// floor(sqrt(W H / pixels)) (at least 1).
 inline int noise_pilot_stride(int width, int height, int pixels) {
   const double k = std::sqrt(static_cast<double>(width) * height / std::max(pixels, 1));
   return std::max(1, static_cast<int>(k));
@@ -95,30 +114,79 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
   noise_pilot_result out;
   const int m = std::max(ps.spp, 2);
   out.stride = noise_pilot_stride(rs.width, rs.height, ps.pixels);
-  const int k = out.stride, x0 = k / 2, y0 = k / 2;
-  const int nx = (rs.width - x0 + k - 1) / k, ny = (rs.height - y0 + k - 1) / k;
-  // Its own seed: the pilot's samples are not the image's.
-  const independent_sampler sampler(rs.seed ^ 0x70696c6f74ull, m);  // "pilot"
+  const int k = out.stride;
+  const int nx = (rs.width + k - 1) / k, ny = (rs.height + k - 1) / k;
+  // The finer blocks of the emission term (header) and its rays per pixel.
+  const int k_rays = ps.emission_rays >= 2 ? ps.emission_rays : 0;
+  const int ke = (k + 1) / 2;
+  const int nxe = k_rays ? (rs.width + ke - 1) / ke : 0, nye = k_rays ? (rs.height + ke - 1) / ke : 0;
+  const int ke_rays =
+      k_rays ? std::max(2, static_cast<int>(std::lround(double(k_rays) * nx * ny / (double(nxe) * nye)))) : 0;
+  // Their own seeds: the pilot's samples are not the image's, nor are its
+  // emission rays its paths', nor its choices of pixels.
+  const independent_sampler sampler(rs.seed ^ 0x70696c6f74ull, m);       // "pilot"
+  const independent_sampler edge_sampler(rs.seed ^ 0x6564676573ull, 1);  // "edges"
+  const independent_sampler pixel_chooser(rs.seed ^ 0x7069636bull, 1);   // "pick"
+  // The pixel drawn in block (i, j) of side b (nb blocks a row; `salt`
+  // tells the two sets of blocks apart), and the block's area over b^2.
+  struct block_pixel {
+    int x, y;
+    double weight;
+  };
+  auto pick = [&](int i, int j, int b, int nb, int salt) {
+    const int bw = std::min(b, rs.width - i * b), bh = std::min(b, rs.height - j * b);
+    auto px = pixel_chooser.start_pixel(i, 2 * j + salt, nb);
+    px.start_sample(0);
+    const vec2 u = px.stream().uniform2();
+    return block_pixel{i * b + std::min(static_cast<int>(u.x * float(bw)), bw - 1),
+                       j * b + std::min(static_cast<int>(u.y * float(bh)), bh - 1), double(bw) * bh / (double(b) * b)};
+  };
   const float inv_w = 1.0f / static_cast<float>(rs.width), inv_h = 1.0f / static_cast<float>(rs.height);
   const path_settings set = rs.path();
 
   unsigned n = rs.threads ? rs.threads : std::max(1u, std::thread::hardware_concurrency());
-  n = std::max(1u, std::min<unsigned>(n, static_cast<unsigned>(ny)));
-  // Per row, summed in row order afterwards: the result does not depend on
-  // which thread took which row (the choices of `auto` depend on it).
+  // A thread per 512 measured pixels at most: starting a thread (~0.1 ms
+  // here) costs more than it saves on a pilot of a few hundred pixels (a
+  // 100 x 100 image at 8 spp: 400 pixels, 0.23 ms on one thread, 0.35 ms
+  // on two).
+  const unsigned measured = static_cast<unsigned>(nx) * static_cast<unsigned>(ny);
+  n = std::max(1u, std::min({n, static_cast<unsigned>(ny), measured / 512u}));
+  // Per row (the pilot's rows, then the finer grid's), summed in row order
+  // afterwards: the result does not depend on which thread took which row
+  // (the choices of `auto` depend on it).
+  const int rows = ny + nye;
   std::atomic<int> next_row{0};
-  std::vector<double> row_sums(static_cast<std::size_t>(ny), 0.0), row_albedo2(static_cast<std::size_t>(ny), 0.0);
+  std::vector<double> row_sums(static_cast<std::size_t>(rows), 0.0), row_weights(static_cast<std::size_t>(rows), 0.0),
+      row_albedo2(static_cast<std::size_t>(ny), 0.0);
   std::vector<int> row_counts(static_cast<std::size_t>(ny), 0), row_diffuse(static_cast<std::size_t>(ny), 0);
-  const int k_rays = ps.emission_rays >= 2 ? ps.emission_rays : 0;
+  std::vector<std::vector<auto_receiver>> row_receivers(static_cast<std::size_t>(ny));
   auto worker = [&] {
     std::vector<glm::dvec3> c(static_cast<std::size_t>(m)), e(static_cast<std::size_t>(m)),
-        ek(static_cast<std::size_t>(std::max(k_rays, 1)));
-    for (int j; (j = next_row.fetch_add(1, std::memory_order_relaxed)) < ny;) {
-      const int y = y0 + j * k;
-      double sum = 0.0, albedo2 = 0.0;
-      int count = 0, diffuse = 0;
+        ek(static_cast<std::size_t>(std::max(ke_rays, 1)));
+    for (int j; (j = next_row.fetch_add(1, std::memory_order_relaxed)) < rows;) {
+      double sum = 0.0, weights = 0.0;
+      int count = 0;
+      if (j >= ny) {
+        // A row of the finer blocks: s2_K(E) of each one's pixel.
+        for (int i = 0; i < nxe; ++i) {
+          const block_pixel b = pick(i, j - ny, ke, nxe, 1);
+          auto px = edge_sampler.start_pixel(b.x, b.y, rs.width);
+          px.start_sample(0);
+          for (int r = 0; r < ke_rays; ++r)
+            ek[static_cast<std::size_t>(r)] =
+                glm::dvec3(radiance_met_first(sc, pixel_ray(cam, b.x, b.y, px.stream().uniform2(), inv_w, inv_h)));
+          sum += b.weight * sample_variance(ek.data(), ke_rays);
+          weights += b.weight;
+        }
+        row_sums[static_cast<std::size_t>(j)] = sum;
+        row_weights[static_cast<std::size_t>(j)] = weights;
+        continue;
+      }
+      double albedo2 = 0.0;
+      int diffuse = 0;
       for (int i = 0; i < nx; ++i) {
-        const int x = x0 + i * k;
+        const block_pixel b = pick(i, j, k, nx, 0);
+        const int x = b.x, y = b.y;
         // The surface at the pixel's centre: its albedo, if diffuse.
         hit_record rec;
         if (sc.hit(pixel_ray(cam, x, y, vec2(0.5f), inv_w, inv_h), sc.ray_epsilon, infinity, rec))
@@ -126,6 +194,7 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
             const double a = (double(l->albedo.r) + l->albedo.g + l->albedo.b) / 3.0;
             albedo2 += a * a;
             ++diffuse;
+            row_receivers[static_cast<std::size_t>(j)].push_back({rec.p, rec.facing_normal()});
           }
         auto px = sampler.start_pixel(x, y, rs.width);
         int finite = 0;
@@ -139,19 +208,14 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
           ++finite;
         }
         if (finite < 2) continue;
-        double var = sample_variance(c.data(), finite);
-        if (k_rays) {
-          // What the camera rays meet first: its two-sample variance out,
-          // its K-ray variance in (header).
-          for (int i = 0; i < k_rays; ++i)
-            ek[static_cast<std::size_t>(i)] =
-                glm::dvec3(radiance_met_first(sc, pixel_ray(cam, x, y, px.stream().uniform2(), inv_w, inv_h)));
-          var += sample_variance(ek.data(), k_rays) - sample_variance(e.data(), finite);
-        }
-        sum += var;
+        // What the camera rays meet first: its variance among these
+        // samples out (put back from the finer grid: header).
+        sum += b.weight * (sample_variance(c.data(), finite) - (k_rays ? sample_variance(e.data(), finite) : 0.0));
+        weights += b.weight;
         ++count;
       }
       row_sums[static_cast<std::size_t>(j)] = sum;
+      row_weights[static_cast<std::size_t>(j)] = weights;
       row_counts[static_cast<std::size_t>(j)] = count;
       row_albedo2[static_cast<std::size_t>(j)] = albedo2;
       row_diffuse[static_cast<std::size_t>(j)] = diffuse;
@@ -165,14 +229,18 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
     worker();
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  double sum = 0.0, albedo2 = 0.0;
+  double sum = 0.0, weights = 0.0, albedo2 = 0.0, edge_sum = 0.0, edge_weights = 0.0;
   int diffuse = 0;
   for (std::size_t j = 0; j < static_cast<std::size_t>(ny); ++j) {
-    sum += row_sums[j], out.pixels += row_counts[j];
+    sum += row_sums[j], weights += row_weights[j], out.pixels += row_counts[j];
     albedo2 += row_albedo2[j], diffuse += row_diffuse[j];
+    out.receivers.insert(out.receivers.end(), row_receivers[j].begin(), row_receivers[j].end());
   }
+  for (std::size_t j = static_cast<std::size_t>(ny); j < static_cast<std::size_t>(rows); ++j)
+    edge_sum += row_sums[j], edge_weights += row_weights[j];
   // (A mean of unbiased terms, one of them subtracted: clamped at 0.)
-  out.image_variance = out.pixels ? std::max(sum / out.pixels, 0.0) : 0.0;
+  if (weights > 0.0)
+    out.image_variance = std::max(sum / weights + (edge_weights > 0.0 ? edge_sum / edge_weights : 0.0), 0.0);
   if (diffuse > 0) out.mean_albedo2 = albedo2 / diffuse;
   return out;
 }

@@ -48,6 +48,7 @@
 // when a receiver first falls in it).
 #include <algorithm>
 #include <limits>
+#include <span>
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
@@ -121,6 +122,20 @@ struct auto_costs {
   // horizon (a numerical inversion) than above it (closed form).
   static constexpr shape_costs sphere_above{74.0f, 54.0f, 100.0f};
   static constexpr shape_costs sphere_crossing{74.0f, 54.0f, 600.0f};
+  // What a light sample pays for the choice itself (the table's lookup and
+  // the dispatch to the chosen sampler), beyond the chosen strategy's cost:
+  // `auto` held to area sampling everywhere against area sampling, 1
+  // thread, interleaved (bench/ab_render.sh, nee, sobol): 5.5 ns per path
+  // on size_rect_1of16 (direct, 256 spp), 22 ns per path of about 3.5 light
+  // samples on size_rect_x4 (global, 64 spp). auto_sampler::table_gain.
+  static constexpr float table_lookup = 6.0f;
+};
+
+// A surface point the image sees (position, unit normal on the viewer's
+// side), as the noise pilot finds them at its pixels' centres: where
+// auto_sampler::table_gain weighs the table's choices against their cost.
+struct auto_receiver {
+  vec3 p, n;
 };
 
 // The variance model at one point: v_area and v_sa from the geometry at the
@@ -202,11 +217,26 @@ class auto_choice {
   //    wrongly favours the dearest, variance-free strategy where vr is small.)
   // Where vr is infinite (nothing to gain at the point) only the cost counts
   // (both forms' limit; the product itself would be infinite for all).
+  // (In the first form a point's scores are in the image's units, so that
+  // they add up over points: auto_sampler::table_gain.)
   static float score(float cost, float v, float vr, const auto_costs::shape_costs& c, const auto_params& p) {
-    if (vr == std::numeric_limits<float>::infinity()) return cost;
-    if (p.image_variance > 0.0f)
-      return cost / (p.rest_cost + std::min({c.area, c.solid_angle, c.projected_solid_angle})) + v / vr;
-    return (cost + p.rest_cost) * (v + vr);
+    const bool infinite = vr == std::numeric_limits<float>::infinity();
+    if (p.image_variance > 0.0f) {
+      const float time = cost / (p.rest_cost + std::min({c.area, c.solid_angle, c.projected_solid_angle}));
+      return infinite ? time : time + v / vr;
+    }
+    return infinite ? cost : (cost + p.rest_cost) * (v + vr);
+  }
+
+  // The score of strategy s at the point, with `extra` ns added to its cost
+  // per light sample (the choice's own, auto_costs::table_lookup).
+  float score_of(light_sampling s, float extra, const auto_costs::shape_costs& c, const auto_params& p) const {
+    const float vr = sg_ > 0.0f ? rest_variance(p) : std::numeric_limits<float>::infinity();
+    switch (s) {
+      case light_sampling::area: return score(c.area + extra, v_area(), vr, c, p);
+      case light_sampling::solid_angle: return score(c.solid_angle + extra, v_solid_angle(), vr, c, p);
+      default: return score(c.projected_solid_angle + extra, 0.0f, vr, c, p);
+    }
   }
 
   // The cheapest strategy: the choice where v_rest is infinite (the light
@@ -258,6 +288,8 @@ class planar_rule {
     int k = 0;
     for (const float s : {lo, hi})
       for (const float t : {lo, hi}) set(coarse_, k++, r.corner + s * r.e1 + t * r.e2, 0.25f);
+    const float edge = std::max(glm::length(r.e1), glm::length(r.e2));
+    coarse_spacing_ = 0.57735027f * edge, fine_spacing_ = 0.38729833f * edge;
     constexpr float x[3] = {0.5f - 0.38729833f, 0.5f, 0.5f + 0.38729833f};
     constexpr float w[3] = {5.0f / 18.0f, 8.0f / 18.0f, 5.0f / 18.0f};
     k = 0;
@@ -274,6 +306,10 @@ class planar_rule {
     // rho^2, weights 5/18, 8/18, 5/18) of four points each, the middle ring
     // turned by 45 degrees. Both exact for quadratics.
     constexpr float kd = 0.70710678f;
+    // Neighbouring points: the coarse ring's, a semi-axis apart; the fine
+    // rule's outer ring's, 0.94 sqrt(2) semi-axes apart.
+    const float semi = std::max(glm::length(e.a1), glm::length(e.a2));
+    coarse_spacing_ = semi, fine_spacing_ = 1.3321343f * semi;
     int k = 0;
     for (const vec3& a : {kd * e.a1, -kd * e.a1, kd * e.a2, -kd * e.a2}) set(coarse_, k++, e.center + a, 0.25f);
     constexpr float rho[3] = {0.33571069f, 0.70710678f, 0.94196515f};
@@ -316,6 +352,7 @@ class planar_rule {
     return true;
   }
 
+  const auto_costs::shape_costs& costs() const { return costs_; }
   auto_choice coarse(const vec3& o, const vec3& n) const { return model(coarse_, o, n); }
   auto_choice fine(const vec3& o, const vec3& n) const { return model(fine_, o, n); }
 
@@ -427,7 +464,13 @@ class planar_rule {
     constexpr float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     s.g_max = 0.0f;
     accumulate4(px, py, pz, zero, o, n, s);
-    ch.set_sums(s.sg, s.sg2, s.sw, s.sg, s.swc2, std::max(s.g_max, g_quad_max));
+    // g's peak is about as wide as o's distance to the light's nearest
+    // point; where that is at least the spacing of the rule's points, they
+    // resolve it, and the rule's own variance stands (the peak's bound is
+    // for a peak that falls between them).
+    const float spacing = N == coarse_points ? coarse_spacing_ : fine_spacing_;
+    const bool resolved = glm::dot(o - a, o - a) >= spacing * spacing;
+    ch.set_sums(s.sg, s.sg2, s.sw, s.sg, s.swc2, resolved ? 0.0f : std::max(s.g_max, g_quad_max));
     ch.set_area_scale(area_ * h);
     return ch;
   }
@@ -436,6 +479,7 @@ class planar_rule {
   vec3 center_, E1_, E2_, nl_;
   float k_;
   float area_;  // the light's area
+  float coarse_spacing_ = 0.0f, fine_spacing_ = 0.0f;  // the largest distance between neighbouring points of each rule
   bool rect_;
   vec3 corner_, dual1_, dual2_;  // rect: corner and e_i / |e_i|^2; ellipse: centre and a_i / |a_i|^2
   points<coarse_points> coarse_;
@@ -494,10 +538,13 @@ inline light_sampling choose_strategy(const ellipse& e, const vec3& o, const vec
 // even twice that leaves the cone ahead of the projected cap, the cone it
 // is (area sampling, dearer, is not ahead of the cone there: its estimate
 // also carries the spread of cos theta_l over the visible cap, 1/3 and more).
+inline bool sphere_above_horizon(const sphere& s, const vec3& o, const vec3& n) {
+  return glm::dot(s.center - o, n) >= s.radius * glm::length(n);
+}
 inline light_sampling choose_strategy(const sphere& s, const vec3& o, const vec3& n, const auto_params& p = {}) {
   const vec3 v = s.center - o;
   const float h = glm::dot(v, n), r2 = s.radius * s.radius, d2 = glm::dot(v, v);
-  const bool above = h >= s.radius * glm::length(n);
+  const bool above = sphere_above_horizon(s, o, n);
   const auto_costs::shape_costs& c = above ? auto_costs::sphere_above : auto_costs::sphere_crossing;
   if (above) {
     const float v_sa = r2 * (d2 - h * h) / (4.0f * d2 * h * h);  // tan^2(theta_c) sin^2(alpha) / 4
@@ -522,10 +569,23 @@ class tabulated_planar_rule {
 
   light_sampling choose(const vec3& o, const vec3& n) const { return table_.lookup(o, n); }
 
+  // The modelled gain (auto_choice::score, the fine rule at o) of the
+  // table's choice at (o, n), its lookup's cost included, over the
+  // cheapest strategy (area sampling).
+  float gain(const vec3& o, const vec3& n) const {
+    const auto_choice m = rule_.fine(o, n);
+    const auto_costs::shape_costs& c = rule_.costs();
+    return m.score_of(auto_choice::cheapest(c), 0.0f, c, params_) - m.score_of(choose(o, n), auto_costs::table_lookup, c, params_);
+  }
+  light_sampling cheapest() const { return auto_choice::cheapest(rule_.costs()); }
+
  private:
   tabulated_planar_rule(const planar_rule& rule, const vec3& c, const vec3& h1, const vec3& h2, const vec3& nl,
                         const auto_params& p)
-      : table_(c, h1, h2, nl, [rule, p](const vec3& o, const vec3& n) { return rule.choose(o, n, p); }) {}
+      : rule_(rule), params_(p),
+        table_(c, h1, h2, nl, [rule, p](const vec3& o, const vec3& n) { return rule.choose(o, n, p); }) {}
+  planar_rule rule_;
+  auto_params params_;
   planar_auto_table table_;
 };
 // Spheres: the rule, tabulated over the receiver's distance and the
@@ -533,10 +593,23 @@ class tabulated_planar_rule {
 class tabulated_sphere_rule {
  public:
   tabulated_sphere_rule(const sphere& s, const auto_params& p)
-      : table_(s.center, s.radius, [s, p](const vec3& o, const vec3& n) { return choose_strategy(s, o, n, p); }) {}
+      : sphere_(s), params_(p),
+        table_(s.center, s.radius, [s, p](const vec3& o, const vec3& n) { return choose_strategy(s, o, n, p); }) {}
   light_sampling choose(const vec3& o, const vec3& n) const { return table_.lookup(o, n); }
 
+  // As tabulated_planar_rule::gain, over the cheapest strategy (the cone).
+  float gain(const vec3& o, const vec3& n) const {
+    const auto_choice m = auto_model(sphere_, o, n);
+    const auto_costs::shape_costs& c =
+        sphere_above_horizon(sphere_, o, n) ? auto_costs::sphere_above : auto_costs::sphere_crossing;
+    return m.score_of(cheapest(), 0.0f, c, params_) - m.score_of(choose(o, n), auto_costs::table_lookup, c, params_);
+  }
+  // The same above the horizon and across it.
+  light_sampling cheapest() const { return auto_choice::cheapest(auto_costs::sphere_above); }
+
  private:
+  sphere sphere_;
+  auto_params params_;
   sphere_auto_table table_;
 };
 template <class Shape>
@@ -565,6 +638,29 @@ struct auto_sampler {
   bool faces(const vec3& o) const { return area.faces(o); }
 
   light_sampling choice(const vec3& o, const vec3& n) const { return rule_.choose(o, n); }
+
+  // Whether the choice pays for itself at the receivers rs (the surfaces an
+  // image's pixels see, from its noise pilot): the mean over them of the
+  // modelled gain of the choice, its own cost per light sample included,
+  // over the cheapest strategy everywhere (auto_choice::score: the mean is
+  // the first-order change of the image's error x time). Where it does not
+  // (a light far from or small to every receiver, or one whose noise is
+  // lost in the image's), the light is better sampled by the cheapest
+  // strategy (cheapest()) everywhere, without a choice per light sample
+  // (`mcrt render` swaps the sampler: src/scene_loader.cpp). The pilot sees
+  // a path's first surfaces only; a light sample at a deeper bounce is
+  // taken to gain as much.
+  // Defined where v_rest comes from the image's noise (image_variance > 0,
+  // the scores' first form); infinite otherwise (the table is kept).
+  float table_gain(std::span<const auto_receiver> rs) const {
+    if (!(params.image_variance > 0.0f)) return std::numeric_limits<float>::infinity();
+    double sum = 0.0;
+    for (const auto_receiver& r : rs) sum += rule_.gain(r.p, r.n);
+    return rs.empty() ? 0.0f : static_cast<float>(sum / double(rs.size()));
+  }
+  // The shape's cheapest strategy (area for planar lights, the cone for
+  // spheres), whose sampler is the member area or solid_angle.
+  light_sampling cheapest() const { return rule_.cheapest(); }
 
   bool sample(const vec3& o, const vec3& n, vec2 u, light_sample& s) const {
     switch (choice(o, n)) {
