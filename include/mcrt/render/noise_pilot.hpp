@@ -24,21 +24,27 @@
 // emitter (or of the background) in view, the radiance the camera ray meets
 // first jumps, and with two samples that pixel's sample variance is either
 // 0 or large: a few such pixels made the pilot's V swing by 6-20x between
-// seeds (the Cornell boxes' ceiling lights). So each pixel's variance is
-// s2(X) - s2(E) + s2_K(E), with E the radiance the camera ray meets first
-// (emission, or background): the part of the two samples' variance that
-// comes from E is taken out and put back as measured by K more camera rays
-// (hit tests only) uniform in the pixel. Each term is an unbiased sample
-// variance of uniform pixel positions, so the sum stays unbiased for the
-// variance of X, with far less spread. The pixels on an emitter's edge are
-// few (a line of them) and carry most of the image's variance where the
-// camera sees a light (with a fixed grid of every stride-th pixel, V
-// differed 1000-fold between the 400- and the 1024-pixel pilots of the
-// Cornell box with the seed's light), so the term s2_K(E) is measured on
-// blocks of half the stride (rounded up), four times as many pixels, with
-// the same number of rays in all (K pixels / pixels_E per pixel, at least
-// 2): V is the mean of s2(X) - s2(E) over the pilot's blocks plus the mean
-// of s2_K(E) over the finer blocks.
+// seeds (the Cornell boxes' ceiling lights). So a sample X is split into E,
+// the radiance the camera ray meets first (emission, or background), and
+// R = X - E, what the surface there reflects: V is the mean of s2(R) (the
+// two samples') over the pilot's blocks plus the mean of s2_K(E), the
+// sample variance of E over K more camera rays (hit tests only) uniform in
+// the pixel. The pixels on an emitter's edge are few (a line of them) and
+// carry most of the image's variance where the camera sees a light (with
+// a fixed grid of every stride-th pixel, V differed 1000-fold between the
+// 400- and the 1024-pixel pilots of the Cornell box with the seed's
+// light), so s2_K(E) is measured on blocks of half the side (rounded up),
+// four times as many pixels, with the same number of rays in all (K
+// pixels / pixels_E per pixel, at least 2). Both terms are unbiased and
+// never negative; their sum falls short of the variance of X by the mean
+// of 2 cov(E, R) over a pixel, small where E and R do not vary together (a
+// light's edge: where a ray meets the emitter it reflects nothing). The
+// unbiased s2(X) - s2(E) + s2_K(E) of each pixel keeps that cross term,
+// which at an edge pixel with two samples is +-|E1 - E2| |R1 - R2|, the
+// light's radiance times the reflected one, offset only by the same
+// pixel's s2_K(E): with s2_K(E) measured on other pixels (commit 8c914c8)
+// the mean fell below 0 (V = 0 at 2 of 8 pilots of a box with a disk
+// light, size_disk_1of4, global).
 //
 // The diffuse surfaces the pixels' centres see are kept too (in pixel
 // order, whichever thread met them), as the receivers at which `auto`
@@ -208,9 +214,11 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
           ++finite;
         }
         if (finite < 2) continue;
-        // What the camera rays meet first: its variance among these
-        // samples out (put back from the finer grid: header).
-        sum += b.weight * (sample_variance(c.data(), finite) - (k_rays ? sample_variance(e.data(), finite) : 0.0));
+        // What the camera rays meet first taken out of each sample (its
+        // variance comes from the finer blocks: header).
+        if (k_rays)
+          for (int i = 0; i < finite; ++i) c[static_cast<std::size_t>(i)] -= e[static_cast<std::size_t>(i)];
+        sum += b.weight * sample_variance(c.data(), finite);
         weights += b.weight;
         ++count;
       }
@@ -238,9 +246,7 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
   }
   for (std::size_t j = static_cast<std::size_t>(ny); j < static_cast<std::size_t>(rows); ++j)
     edge_sum += row_sums[j], edge_weights += row_weights[j];
-  // (A mean of unbiased terms, one of them subtracted: clamped at 0.)
-  if (weights > 0.0)
-    out.image_variance = std::max(sum / weights + (edge_weights > 0.0 ? edge_sum / edge_weights : 0.0), 0.0);
+  if (weights > 0.0) out.image_variance = sum / weights + (edge_weights > 0.0 ? edge_sum / edge_weights : 0.0);
   if (diffuse > 0) out.mean_albedo2 = albedo2 / diffuse;
   return out;
 }

@@ -38,10 +38,10 @@
 // "Choosing per shading point", which also says how far this rule is from
 // the best fixed strategy).
 //
-// Where a receiver is close to a planar light (within a fraction of its
-// size) g peaks near the light's nearest point and no fixed quadrature
-// sees the peak; the model then takes the peak's own variance (see
-// auto_choice::v_area). auto_sampler evaluates the rule of a light once
+// Where a receiver is close to a planar light (nearer to it than the
+// rule's points are to each other) g peaks near the light's nearest point
+// and no fixed quadrature sees the peak; the model then takes the peak's
+// own variance (see auto_choice::v_area). auto_sampler evaluates the rule of a light once
 // per cell of a table of receiver positions and normals (auto_table.hpp;
 // for a sphere, of distances and normals' angles to its centre), so a
 // shading point pays a lookup, not the rule (and each cell the rule once,
@@ -159,7 +159,8 @@ class auto_choice {
 
   // The weighted sums of a planar light's points, formed by planar_rule
   // (with cos(theta_l) = h / r, h the receiver's height over the plane,
-  // which cancels from both ratios and is left out of every sum).
+  // which cancels from both ratios and is left out of every sum); g_peak
+  // the peak of g / h the rule's points miss, 0 where they resolve it.
   void set_sums(float sg, float sg2, float sw, float swc, float swc2, float g_peak) {
     sg_ = sg, sg2_ = sg2, sw_ = sw, swc_ = swc, swc2_ = swc2, g_peak_ = g_peak;
   }
@@ -173,9 +174,10 @@ class auto_choice {
 
   // Relative variances of the area and solid-angle estimates (header).
   // v_area: the quadrature's, unless g at the light's nearest point exceeds
-  // twice the quadrature's mean: then the receiver is close to the light
-  // (within a fraction of its size), g ~ delta^2 / r^4 peaks at the nearest
-  // point, and a fixed rule misses the peak; there the variance of that
+  // twice the quadrature's mean and the rule's points do not resolve the
+  // peak (planar_rule::model sets g_peak only then): then the receiver is
+  // close to the light, g ~ delta^2 / r^4 peaks at the nearest point, and a
+  // fixed rule misses the peak; there the variance of that
   // peak, (q - 1) / 3 with q = g_peak / E[g] (for g = delta^2 / r^4 over a
   // large light E_A[g^2] / E_A[g]^2 = A / (3 pi delta^2) = q / 3), bounds it
   // from below. At q = 2 both forms give 1/3 (g linear from 0 to 2 E[g]).
