@@ -41,11 +41,13 @@
 // Where a receiver is close to a planar light (nearer to it than the
 // rule's points are to each other) g peaks near the light's nearest point
 // and no fixed quadrature sees the peak; the model then takes the peak's
-// own variance (see auto_choice::v_area). auto_sampler evaluates the rule of a light once
-// per cell of a table of receiver positions and normals (auto_table.hpp;
-// for a sphere, of distances and normals' angles to its centre), so a
-// shading point pays a lookup, not the rule (and each cell the rule once,
-// when a receiver first falls in it).
+// own variance (see auto_choice::v_area). auto_sampler evaluates the rule
+// of a light once per cell of a table of receiver positions and normals
+// (auto_table.hpp; for a sphere, of distances and normals' angles to its
+// centre), so a shading point pays a lookup, not the rule (and each cell
+// the rule once, when a receiver first falls in it); and where even that
+// does not pay at the surfaces the image sees, the light takes its
+// cheapest strategy everywhere (auto_sampler::table_gain).
 #include <algorithm>
 #include <limits>
 #include <span>
@@ -481,7 +483,7 @@ class planar_rule {
   vec3 center_, E1_, E2_, nl_;
   float k_;
   float area_;  // the light's area
-  float coarse_spacing_ = 0.0f, fine_spacing_ = 0.0f;  // the largest distance between neighbouring points of each rule
+  float coarse_spacing_ = 0.0f, fine_spacing_ = 0.0f;  // largest distance between neighbouring points of each rule
   bool rect_;
   vec3 corner_, dual1_, dual2_;  // rect: corner and e_i / |e_i|^2; ellipse: centre and a_i / |a_i|^2
   points<coarse_points> coarse_;
@@ -577,7 +579,8 @@ class tabulated_planar_rule {
   float gain(const vec3& o, const vec3& n) const {
     const auto_choice m = rule_.fine(o, n);
     const auto_costs::shape_costs& c = rule_.costs();
-    return m.score_of(auto_choice::cheapest(c), 0.0f, c, params_) - m.score_of(choose(o, n), auto_costs::table_lookup, c, params_);
+    return m.score_of(auto_choice::cheapest(c), 0.0f, c, params_) -
+           m.score_of(choose(o, n), auto_costs::table_lookup, c, params_);
   }
   light_sampling cheapest() const { return auto_choice::cheapest(rule_.costs()); }
 
