@@ -163,8 +163,8 @@ int run_render(const render_options& opt) {
     j["scene"] = ls.name;
     j["nonfinite_samples"] = res.nonfinite_samples;
     if (ls.auto_lights > 0) j["auto_setup_seconds"] = ls.auto_setup_seconds;
-    if (noise) j["auto_cheapest_lights"] = ls.auto_cheapest_lights.size();
     if (noise) {
+      j["auto_cheapest_lights"] = ls.auto_cheapest_lights.size();
       j["auto_pilot_seconds"] = noise->seconds;
       j["auto_image_variance"] = noise->image_variance;
       j["auto_albedo"] = std::sqrt(noise->mean_albedo2);

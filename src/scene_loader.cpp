@@ -9,7 +9,6 @@
 #include <set>
 #include <span>
 #include <sstream>
-#include <variant>
 
 namespace mcrt::cli {
 namespace {
@@ -319,24 +318,8 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
       // Where its choice does not pay for its own cost at the pilot's
       // receivers, the light takes its cheapest strategy's sampler, with no
       // choice per light sample (auto_sampler::table_gain).
-      if (!auto_receivers.empty()) {
-        std::optional<light> cheapest;
-        std::visit(
-            [&]<class S>(const S& l) {
-              if constexpr (strategy_of<S>() == light_sampling::automatic)
-                if (!(l.table_gain(auto_receivers) > 0.0f)) {
-                  if (l.cheapest() == light_sampling::area)
-                    cheapest = l.area;
-                  else
-                    cheapest = l.solid_angle;
-                }
-            },
-            world.lights.back());
-        if (cheapest) {
-          world.lights.back() = std::move(*cheapest);
-          out.auto_cheapest_lights.push_back(static_cast<std::uint32_t>(world.lights.size() - 1));
-        }
-      }
+      if (!auto_receivers.empty() && use_cheapest_where_choice_does_not_pay(world.lights.back(), auto_receivers))
+        out.auto_cheapest_lights.push_back(static_cast<std::uint32_t>(world.lights.size() - 1));
       out.auto_setup_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       return;
     }

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "mcrt/core/rng.hpp"
+#include "mcrt/render/light.hpp"
 #include "mcrt/sampling/auto_strategy.hpp"
 #include "support/chi2.hpp"
 #include "support/lambert.hpp"
@@ -229,6 +230,18 @@ TEST(AutoStrategy, TableGainWeighsTheChoiceAgainstItsCost) {
   const rect_auto_sampler fixed(lamp, auto_params{});
   EXPECT_EQ(fixed.table_gain(near), std::numeric_limits<float>::infinity());
   EXPECT_EQ(rs.table_gain({}), 0.0f);
+  // The swap (render/light.hpp): the cheapest strategy's sampler where the
+  // choice does not pay, the auto sampler kept where it does, any other
+  // strategy left alone.
+  light l = rs;
+  EXPECT_FALSE(use_cheapest_where_choice_does_not_pay(l, near));
+  EXPECT_TRUE(std::holds_alternative<rect_auto_sampler>(l));
+  EXPECT_TRUE(use_cheapest_where_choice_does_not_pay(l, far));
+  EXPECT_TRUE(std::holds_alternative<rect_area_sampler>(l));
+  light cone = ss;
+  EXPECT_TRUE(use_cheapest_where_choice_does_not_pay(cone, far));
+  EXPECT_TRUE(std::holds_alternative<sphere_cone_sampler>(cone));
+  EXPECT_FALSE(use_cheapest_where_choice_does_not_pay(cone, far));
 }
 
 // The auto strategy is the chosen strategy, bit for bit: the same sample

@@ -3,6 +3,8 @@
 // sampling strategy, in one std::variant so a scene holds exactly the
 // strategies it uses and dispatch is a few compares, not a virtual call.
 #include <concepts>
+#include <optional>
+#include <span>
 #include <type_traits>
 #include <variant>
 
@@ -55,6 +57,28 @@ constexpr light_sampling strategy_of() {
 }
 inline light_sampling strategy_of(const light& l) {
   return dispatch(l, []<class S>(const S&) { return strategy_of<S>(); });
+}
+
+// A light sampled by `auto` whose choice per shading point does not pay for
+// its own cost at the receivers rs (auto_sampler::table_gain) becomes its
+// cheapest strategy's sampler, with no choice per light sample. Returns
+// whether it did; other lights are left as they are.
+inline bool use_cheapest_where_choice_does_not_pay(light& l, std::span<const auto_receiver> rs) {
+  std::optional<light> cheapest;
+  std::visit(
+      [&]<class S>(const S& s) {
+        if constexpr (strategy_of<S>() == light_sampling::automatic)
+          if (!(s.table_gain(rs) > 0.0f)) {
+            if (s.cheapest() == light_sampling::area)
+              cheapest = s.area;
+            else
+              cheapest = s.solid_angle;
+          }
+      },
+      l);
+  if (!cheapest) return false;
+  l = std::move(*cheapest);
+  return true;
 }
 
 // The free functions light_pdf (render/pdf.hpp) and the integrators call:

@@ -69,12 +69,14 @@ namespace mcrt {
 struct noise_pilot_settings {
   int pixels = 1024;       // about this many pixels of the image (all, for smaller images)
   int spp = 2;             // samples per pixel (>= 2: a sample variance needs two)
-  int emission_rays = 8;   // K camera rays per pixel for the variance of what they meet first (< 2: none)
+  int emission_rays = 8;   // K: camera rays per measured pixel, spread over the finer blocks, for the
+                           // variance of what they meet first (header; < 2: none)
 };
 
 // The pilot `mcrt render` runs for an image of width x height at spp: 1024
 // pixels, or fewer where that would exceed 1 % of the image's samples (at
-// least 64), with 2 samples and 8 emission rays (hit tests) each.
+// least 64), with 2 samples each and 8 emission rays (hit tests) per
+// measured pixel, cast on the finer blocks.
 inline noise_pilot_settings noise_pilot_for(int width, int height, int spp) {
   const double budget = 0.01 * static_cast<double>(width) * height * spp / 2.0;  // pixels at 2 samples
   return {static_cast<int>(std::clamp(budget, 64.0, 1024.0)), 2, 8};

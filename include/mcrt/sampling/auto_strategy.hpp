@@ -652,7 +652,7 @@ struct auto_sampler {
   // (a light far from or small to every receiver, or one whose noise is
   // lost in the image's), the light is better sampled by the cheapest
   // strategy (cheapest()) everywhere, without a choice per light sample
-  // (`mcrt render` swaps the sampler: src/scene_loader.cpp). The pilot sees
+  // (render/light.hpp: use_cheapest_where_choice_does_not_pay). The pilot sees
   // a path's first surfaces only; a light sample at a deeper bounce is
   // taken to gain as much.
   // Defined where v_rest comes from the image's noise (image_variance > 0,
