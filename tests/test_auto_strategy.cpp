@@ -160,6 +160,31 @@ TEST(AutoStrategy, ModelVariancesNearDisk) {
   check_model_near<ellipse, ellipse_area_sampler, ellipse_solid_angle_sampler>(unit_disk());
 }
 
+// Where g peaks between the rule's points (just under a light's middle,
+// 0.02-0.1 light sizes away), the rule's mean of g is far off: its middle
+// point sits on the peak (the rectangle's 3x3 rule gives 5-126x the true
+// mean there). The model's Omega_proj is the exact one there (Lambert's
+// sum; on the disk's axis pi R^2 / (R^2 + h^2)), and the peak's bound is
+// taken against it: v_area >= (A / (Omega_proj h^2) - 1) / 3 (g / h peaks
+// at 1 / h^3 at the foot, its mean is Omega_proj / (A h)).
+TEST(AutoStrategy, ExactProjectedSolidAngleWhereGPeaks) {
+  const vec3 up{0, 1, 0};
+  const std::vector<glm::dvec3> poly{{-0.5, 0, -0.4}, {0.5, 0, -0.4}, {0.5, 0, 0.4}, {-0.5, 0, 0.4}};
+  for (const float h : {0.02f, 0.05f, 0.1f}) {
+    const vec3 o{0.0f, -h, 0.0f};
+    const auto m = auto_model(unit_rect(), o, up);
+    ASSERT_TRUE(m.peaked()) << h;
+    const double exact = test::polygon_irradiance(glm::dvec3(o), {0, 1, 0}, poly, 1.0);
+    EXPECT_NEAR(m.omega_proj(), exact, 1e-4 * exact) << h;
+    EXPECT_GE(m.v_area(), (1.0 - 1e-4) * (0.8 / (exact * h * h) - 1.0) / 3.0) << h;
+    const auto md = auto_model(unit_disk(), o, up);
+    ASSERT_TRUE(md.peaked()) << h;
+    const double exact_d = std::numbers::pi * 0.25 / (0.25 + double(h) * h);
+    EXPECT_NEAR(md.omega_proj(), exact_d, 1e-4 * exact_d) << h;
+    EXPECT_GE(md.v_area(), (1.0 - 1e-4) * (std::numbers::pi * 0.25 / (exact_d * h * h) - 1.0) / 3.0) << h;
+  }
+}
+
 TEST(AutoStrategy, ModelVariancesRect) { check_model<rect, rect_area_sampler, rect_solid_angle_sampler>(unit_rect()); }
 TEST(AutoStrategy, ModelVariancesDisk) {
   check_model<ellipse, ellipse_area_sampler, ellipse_solid_angle_sampler>(unit_disk());

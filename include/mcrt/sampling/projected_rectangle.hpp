@@ -549,6 +549,16 @@ struct rect_projected_solid_angle_sampler {
     return p <= double(FLT_MAX) ? float(p) : 0.0f;
   }
 
+  // The light's projected solid angle at o for the normal n (sr,
+  // projected): Lambert's sum over the visible part's edges, or its
+  // cancellation-free forms (projected_rectangle); 0 where no part is
+  // visible (and where no form is well conditioned: the area fallback's
+  // receivers, right in the light's plane).
+  double projected_solid_angle(const vec3& o, const vec3& n) const {
+    const projected_rectangle pr(frame_, shape.corner, o, n);
+    return pr.how() == projected_rectangle::method::map ? pr.projected_solid_angle() : 0.0;
+  }
+
   // Unit direction dir -> the unit-square point sample() maps onto it
   // (projected_polygon::invert, or the area fallback's inverse); false (u
   // untouched) where pdf() is 0.

@@ -663,6 +663,14 @@ struct ellipse_projected_solid_angle_sampler {
     return true;
   }
 
+  // The light's projected solid angle at o for the normal n (sr,
+  // projected): K / 2 of the exact mode; 0 where it has none (nothing
+  // visible, or the fallback's receivers).
+  double projected_solid_angle(const vec3& o, const vec3& n) const {
+    const projected_spherical_ellipse ps = setup(o, n);
+    return ps.mode == projected_ellipse_mode::exact ? ps.omega_proj() : 0.0;
+  }
+
   const ellipse_frame& frame() const { return fallback_.frame(); }
 
  private:
