@@ -10,7 +10,6 @@
 #include <limits>
 #include <optional>
 #include <string>
-#include <vector>
 
 #include "image_io.hpp"
 #include "render_instances.hpp"
@@ -119,29 +118,17 @@ int run_render(const render_options& opt) {
 
   std::optional<noise_pilot_result> noise;
   double edge_factor = 1.0;  // kappa_E (render/noise_pilot.hpp)
-  std::vector<double> light_factors;  // kappa of each light `auto` samples (render/light_noise_pilot.hpp)
-  std::vector<float> light_variances;  // the image's noise as each one's samples see it
   if (pilot && ls.auto_lights > 0) {
     noise = estimate_image_variance(ls.world, cam, rs, noise_pilot_for(rs.width, rs.height, rs.spp));
-    // What the image's own samples leave of the emission term (kappa_E,
-    // render/noise_pilot.hpp) and of each light's noise (kappa, render/
-    // light_noise_pilot.hpp): the image's noise as each light's samples see
-    // it is V_R + (kappa_E / kappa) V_E.
+    // The emission term with the image's own samples (render/noise_pilot.hpp).
     const auto start = std::chrono::steady_clock::now();
     edge_factor = edge_noise_factor(ls.world, cam, rs, noise->edge_pixels);
-    const double path_variance = noise->image_variance - noise->edge_variance;
-    for (const std::uint32_t i : ls.auto_light_indices) {
-      const double k = light_noise_factor(ls.world, i, noise->receivers, rs.sampler, rs.spp, rs.seed,
-                                          light_noise_pilot_for(rs.width, rs.height));
-      light_factors.push_back(k);
-      const double v = path_variance + (k > 0.0 ? edge_factor / k : 1.0) * noise->edge_variance;
-      // A noise-free pilot leaves nothing for a cheaper strategy to hide in.
-      light_variances.push_back(std::max(static_cast<float>(v), std::numeric_limits<float>::min()));
-    }
     noise->seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    ap.image_variance = std::max(static_cast<float>(noise->image_variance), std::numeric_limits<float>::min());
+    const double v = noise->image_variance - (1.0 - edge_factor) * noise->edge_variance;
+    // A noise-free pilot leaves nothing for a cheaper strategy to hide in.
+    ap.image_variance = std::max(static_cast<float>(v), std::numeric_limits<float>::min());
     ap.albedo = static_cast<float>(std::sqrt(noise->mean_albedo2));
-    ls = load_scene(opt.scene, strategy, map, ap, false, noise->receivers, light_variances);
+    ls = load_scene(opt.scene, strategy, map, ap, false, noise->receivers);
   }
 
   render_result res = render_scene(ls.world, cam, rs, opt.quiet ? progress_callback{} : progress_callback(print_progress));
@@ -186,11 +173,9 @@ int run_render(const render_options& opt) {
     if (noise) {
       j["auto_cheapest_lights"] = ls.auto_cheapest_lights.size();
       j["auto_pilot_seconds"] = noise->seconds;
-      j["auto_image_variance"] = noise->image_variance;
-      j["auto_image_variance_edges"] = noise->edge_variance;
+      j["auto_image_variance"] = noise->image_variance - (1.0 - edge_factor) * noise->edge_variance;
+      j["auto_image_variance_edges"] = edge_factor * noise->edge_variance;
       j["auto_edge_noise_factor"] = edge_factor;
-      j["auto_light_noise_factors"] = light_factors;
-      j["auto_light_image_variances"] = light_variances;
       j["auto_albedo"] = std::sqrt(noise->mean_albedo2);
     }
     write_text(opt.stats, j.dump(2) + "\n");

@@ -259,8 +259,7 @@ constexpr const char* strategy_names = "area, solid-angle, projected-solid-angle
 void read_object(const reader& rd, const json& o, const std::string& path, scene& world,
                  const std::map<std::string, std::uint32_t>& material_ids,
                  std::optional<light_sampling> override_strategy, ellipse_map map, const auto_params& ap,
-                 bool auto_pilot, std::span<const auto_receiver> auto_receivers,
-                 std::span<const float> auto_image_variances, loaded_scene& out) {
+                 bool auto_pilot, std::span<const auto_receiver> auto_receivers, loaded_scene& out) {
   if (!o.is_object()) rd.ctx.fail(path, std::string("expected an object, got ") + type_name(o));
   std::string type = rd.string(o, path, "type");
   const std::string mat_name = rd.string(o, path, "material");
@@ -303,20 +302,15 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
     }
     if (strategy == light_sampling::automatic && is_light) {
       ++out.auto_lights;
-      out.auto_light_indices.push_back(static_cast<std::uint32_t>(world.lights.size()));
       // The noise pilot's scene: the shape's default strategy (its cheapest).
       if (auto_pilot) {
         add_light(world, shape, mat, std::nullopt, map, ap);
         return;
       }
-      // The light's radiance (the mean of its channels) for the rule's
-      // v_rest, and the image's noise as this light's samples see it, where
-      // measured for each light.
+      // The light's radiance (the mean of its channels) for the rule's v_rest.
       auto_params lp = ap;
       const color e = std::get<diffuse_light>(world.materials[mat]).emit;
       lp.radiance = (e.r + e.g + e.b) / 3.0f;
-      if (static_cast<std::size_t>(out.auto_lights) <= auto_image_variances.size())
-        lp.image_variance = auto_image_variances[static_cast<std::size_t>(out.auto_lights - 1)];
       // Its set-up (the rule's constants and its table's cells, not yet
       // evaluated) is part of the image's time (loaded_scene).
       const auto start = std::chrono::steady_clock::now();
@@ -381,8 +375,7 @@ std::optional<light_sampling> parse_light_sampling_flag(const std::string& value
 }
 
 loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy, ellipse_map map,
-                        const auto_params& ap, bool auto_pilot, std::span<const auto_receiver> auto_receivers,
-                        std::span<const float> auto_image_variances) {
+                        const auto_params& ap, bool auto_pilot, std::span<const auto_receiver> auto_receivers) {
   const context ctx{path};
   const reader rd{ctx};
   std::ifstream in(path, std::ios::binary);
@@ -435,7 +428,7 @@ loaded_scene load_scene(const std::string& path, std::optional<light_sampling> o
   if (objs.empty()) ctx.fail("objects", "the scene has no objects");
   for (std::size_t i = 0; i < objs.size(); ++i)
     read_object(rd, objs[i], "objects[" + std::to_string(i) + "]", out.world, ids, override_strategy, map, ap, auto_pilot,
-                auto_receivers, auto_image_variances, out);
+                auto_receivers, out);
 
   // Self-intersection guard proportional to the scene's coordinates: a few
   // thousand float ulps of the largest coordinate (1.1e-3 for the 555-unit

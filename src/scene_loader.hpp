@@ -34,9 +34,6 @@ struct loaded_scene {
   camera_desc cam;
   int spp = 100, max_depth = 50;
   int auto_lights = 0;  // lights sampled by `auto`
-  // Their indices in world.lights, in the scene file's order (in the noise
-  // pilot's scene, where they take their cheapest strategy, too).
-  std::vector<std::uint32_t> auto_light_indices;
   // Time spent making those lights' samplers (seconds): `mcrt render` counts
   // it in the image's time, as it does the noise pilot.
   double auto_setup_seconds = 0.0;
@@ -66,11 +63,8 @@ std::optional<light_sampling> parse_light_sampling_flag(const std::string& value
 // auto_receivers: the surfaces the noise pilot's pixels see; where given, a
 // light sampled by `auto` whose choice does not pay for its cost there
 // takes its cheapest strategy everywhere (auto_sampler::table_gain).
-// auto_image_variances: where given, one per light sampled by `auto` (in
-// auto_light_indices' order), its auto_params::image_variance.
 loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy = std::nullopt,
                         ellipse_map map = ellipse_map::parallel, const auto_params& ap = {}, bool auto_pilot = false,
-                        std::span<const auto_receiver> auto_receivers = {},
-                        std::span<const float> auto_image_variances = {});
+                        std::span<const auto_receiver> auto_receivers = {});
 
 }  // namespace mcrt::cli

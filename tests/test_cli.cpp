@@ -346,29 +346,6 @@ TEST_F(Cli, AutoNoisePilotInStats) {
   EXPECT_GT(j["auto_setup_seconds"].get<double>(), 0.0);
   EXPECT_LE(j["auto_pilot_seconds"].get<double>() + j["auto_setup_seconds"].get<double>(),
             j["render_seconds"].get<double>());
-  // The emission term with the image's samples (no emitter in view here:
-  // no edge pixels, kappa_E = 1, the term 0), and with independent samples
-  // kappa_E = 1.
-  for (const char* sampler : {"sobol", "independent"}) {
-    ASSERT_EQ(run(base + "--light-sampling auto --sampler " + sampler).status, 0) << sampler;
-    j = nlohmann::json::parse(slurp(stats));
-    ASSERT_TRUE(j.contains("auto_edge_noise_factor") && j.contains("auto_image_variance_edges")) << sampler;
-    EXPECT_EQ(j["auto_edge_noise_factor"].get<double>(), 1.0) << sampler;
-    EXPECT_GE(j["auto_image_variance_edges"].get<double>(), 0.0) << sampler;
-    EXPECT_LE(j["auto_image_variance_edges"].get<double>(), j["auto_image_variance"].get<double>()) << sampler;
-    // One lamp sampled by `auto`: its kappa (1 for independent samples, a
-    // smooth lamp's noise well below 1 with Sobol points) and the V its
-    // rule uses (V itself here: no edges in view).
-    ASSERT_EQ(j["auto_light_noise_factors"].size(), 1u) << sampler;
-    ASSERT_EQ(j["auto_light_image_variances"].size(), 1u) << sampler;
-    const double k = j["auto_light_noise_factors"][0].get<double>();
-    if (std::string(sampler) == "independent")
-      EXPECT_EQ(k, 1.0);
-    else
-      EXPECT_LT(k, 0.5);
-    EXPECT_NEAR(j["auto_light_image_variances"][0].get<double>(), j["auto_image_variance"].get<double>(),
-                1e-6 * j["auto_image_variance"].get<double>()) << sampler;
-  }
   for (const char* flags : {"--light-sampling auto --auto-rest-variance 4", "--light-sampling area", ""}) {
     ASSERT_EQ(run(base + flags).status, 0) << flags;
     j = nlohmann::json::parse(slurp(stats));

@@ -24,7 +24,6 @@
 #include "mcrt/render/light_selection.hpp"
 #include "mcrt/render/mis.hpp"
 #include "mcrt/render/mis_integrator.hpp"
-#include "mcrt/render/light_noise_pilot.hpp"
 #include "mcrt/render/noise_pilot.hpp"
 #include "mcrt/render/mixture_integrator.hpp"
 #include "mcrt/render/nee_integrator.hpp"
