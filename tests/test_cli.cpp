@@ -346,6 +346,16 @@ TEST_F(Cli, AutoNoisePilotInStats) {
   EXPECT_GT(j["auto_setup_seconds"].get<double>(), 0.0);
   EXPECT_LE(j["auto_pilot_seconds"].get<double>() + j["auto_setup_seconds"].get<double>(),
             j["render_seconds"].get<double>());
+  // The emission term with the image's samples (no emitter in view here:
+  // no edge pixels, kappa_E = 1), and with independent samples kappa_E = 1.
+  for (const char* sampler : {"sobol", "independent"}) {
+    ASSERT_EQ(run(base + "--light-sampling auto --sampler " + sampler).status, 0) << sampler;
+    j = nlohmann::json::parse(slurp(stats));
+    ASSERT_TRUE(j.contains("auto_edge_noise_factor") && j.contains("auto_image_variance_edges")) << sampler;
+    EXPECT_EQ(j["auto_edge_noise_factor"].get<double>(), 1.0) << sampler;
+    EXPECT_GE(j["auto_image_variance_edges"].get<double>(), 0.0) << sampler;
+    EXPECT_LE(j["auto_image_variance_edges"].get<double>(), j["auto_image_variance"].get<double>()) << sampler;
+  }
   for (const char* flags : {"--light-sampling auto --auto-rest-variance 4", "--light-sampling area", ""}) {
     ASSERT_EQ(run(base + flags).status, 0) << flags;
     j = nlohmann::json::parse(slurp(stats));
