@@ -123,10 +123,10 @@ int run_render(const render_options& opt) {
     // The emission term with the image's own samples (render/noise_pilot.hpp).
     const auto start = std::chrono::steady_clock::now();
     edge_factor = edge_noise_factor(ls.world, cam, rs, noise->edge_pixels);
+    scale_emission_term(*noise, edge_factor);
     noise->seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const double v = noise->image_variance - (1.0 - edge_factor) * noise->edge_variance;
     // A noise-free pilot leaves nothing for a cheaper strategy to hide in.
-    ap.image_variance = std::max(static_cast<float>(v), std::numeric_limits<float>::min());
+    ap.image_variance = std::max(static_cast<float>(noise->image_variance), std::numeric_limits<float>::min());
     ap.albedo = static_cast<float>(std::sqrt(noise->mean_albedo2));
     ls = load_scene(opt.scene, strategy, map, ap, false, noise->receivers);
   }
@@ -173,8 +173,8 @@ int run_render(const render_options& opt) {
     if (noise) {
       j["auto_cheapest_lights"] = ls.auto_cheapest_lights.size();
       j["auto_pilot_seconds"] = noise->seconds;
-      j["auto_image_variance"] = noise->image_variance - (1.0 - edge_factor) * noise->edge_variance;
-      j["auto_image_variance_edges"] = edge_factor * noise->edge_variance;
+      j["auto_image_variance"] = noise->image_variance;
+      j["auto_image_variance_edges"] = noise->edge_variance;
       j["auto_edge_noise_factor"] = edge_factor;
       j["auto_albedo"] = std::sqrt(noise->mean_albedo2);
     }

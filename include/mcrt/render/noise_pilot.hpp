@@ -279,6 +279,13 @@ noise_pilot_result estimate_image_variance(const Scene& sc, const camera& cam, c
                          [&]<class I>() { return estimate_image_variance_with<I>(sc, cam, rs, ps); });
 }
 
+// The pilot's result with its emission term as the image's samples leave
+// it (kappa_E from edge_noise_factor below): V and its emission term.
+inline void scale_emission_term(noise_pilot_result& r, double kappa_e) {
+  r.image_variance -= (1.0 - kappa_e) * r.edge_variance;
+  r.edge_variance *= kappa_e;
+}
+
 // What the image's sample generator leaves of the emission term: kappa_E
 // = sum_x w_x N Var_m(mean of E over N camera rays) / sum_x w_x Var(E of
 // one ray), over the pilot's edge pixels x (at most `pixels` of them,
@@ -306,28 +313,22 @@ double edge_noise_factor_with(const Scene& sc, const camera& cam, const render_s
   for (int j = 0; j < m; ++j) samplers.emplace_back(mix64(rs.seed ^ 0x6564676571ull) + std::uint64_t(j), n);
   const float inv_w = 1.0f / static_cast<float>(rs.width), inv_h = 1.0f / static_cast<float>(rs.height);
   double between = 0.0, within = 0.0;
-  std::vector<glm::dvec3> means(static_cast<std::size_t>(m));
+  std::vector<glm::dvec3> means(static_cast<std::size_t>(m)), rays(static_cast<std::size_t>(m) * n);
   for (std::size_t i = 0; i < count; ++i) {
     const edge_pixel& e = edges[i * edges.size() / count];
-    glm::dvec3 sum(0.0), sum2(0.0);
     for (int j = 0; j < m; ++j) {
       auto px = samplers[static_cast<std::size_t>(j)].start_pixel(e.x, e.y, rs.width);
       glm::dvec3 s(0.0);
       for (int k = 0; k < n; ++k) {
         px.start_sample(k);
         const glm::dvec3 v(radiance_met_first(sc, camera_ray(cam, px, e.x, e.y, inv_w, inv_h)));
-        s += v, sum2 += v * v;
+        rays[static_cast<std::size_t>(j) * n + k] = v;
+        s += v;
       }
-      sum += s;
       means[static_cast<std::size_t>(j)] = s / double(n);
     }
-    const double total = double(m) * n;
-    const glm::dvec3 mean = sum / total;
-    glm::dvec3 ss(0.0);
-    for (const glm::dvec3& x : means) ss += (x - mean) * (x - mean);
-    const glm::dvec3 w = glm::max(sum2 - total * mean * mean, glm::dvec3(0.0)) / (total - 1.0);
-    between += e.weight * double(n) * (ss.x + ss.y + ss.z) / (3.0 * (m - 1));
-    within += e.weight * (w.x + w.y + w.z) / 3.0;
+    between += e.weight * double(n) * sample_variance(means.data(), m);
+    within += e.weight * sample_variance(rays.data(), m * n);
   }
   return within > 0.0 ? between / within : 1.0;
 }

@@ -174,12 +174,12 @@ class auto_choice {
   // The light's projected solid angle at the point is the quadrature's mean
   // of g times the area the points cover (area_scale; for a planar light
   // its area times the receiver's height, h being left out of the sums).
-  void set_area_scale(float area_scale) { omega_proj_ = area_scale * sg_, mean_g_ = sg_; }
+  void set_area_scale(float area_scale) { omega_proj_ = area_scale * sg_; }
   // Where g peaks between the rule's points (peaked()), its mean is as far
   // off as its variance: there the exact Omega_proj (Lambert's, from the
   // projected-solid-angle sampler) sets omega_proj() and the mean of g the
   // peak's bound is taken against (v_area), mean_g = Omega_proj /
-  // area_scale.
+  // area_scale (elsewhere the quadrature's mean).
   void set_exact_omega_proj(float omega_proj, float area_scale) {
     omega_proj_ = omega_proj, mean_g_ = omega_proj / area_scale;
   }
