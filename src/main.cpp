@@ -118,6 +118,7 @@ int run_render(const render_options& opt) {
 
   std::optional<noise_pilot_result> noise;
   double edge_factor = 1.0;  // kappa_E (render/noise_pilot.hpp)
+  std::vector<auto_light_settlement> settlements;
   if (pilot && ls.auto_lights > 0) {
     noise = estimate_image_variance(ls.world, cam, rs, noise_pilot_for(rs.width, rs.height, rs.spp));
     // The emission term with the image's own samples (render/noise_pilot.hpp).
@@ -128,7 +129,15 @@ int run_render(const render_options& opt) {
     // A noise-free pilot leaves nothing for a cheaper strategy to hide in.
     ap.image_variance = std::max(static_cast<float>(noise->image_variance), std::numeric_limits<float>::min());
     ap.albedo = static_cast<float>(std::sqrt(noise->mean_albedo2));
-    ls = load_scene(opt.scene, strategy, map, ap, false, noise->receivers);
+    ls = load_scene(opt.scene, strategy, map, ap, false);
+    // Each light's rule with the image's noise as the image's samples leave
+    // it, and the gate of its choice (render/choice_gain_pilot.hpp).
+    const auto settle_start = std::chrono::steady_clock::now();
+    settlements = settle_auto_lights(ls.world, cam, rs, *noise, choice_gain_pixels_for(rs.width, rs.height),
+                                     !opt.auto_rest_cost);
+    for (const auto_light_settlement& a : settlements)
+      if (a.cheapest) ls.auto_cheapest_lights.push_back(static_cast<std::uint32_t>(a.light));
+    noise->seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - settle_start).count();
   }
 
   render_result res = render_scene(ls.world, cam, rs, opt.quiet ? progress_callback{} : progress_callback(print_progress));
@@ -177,6 +186,17 @@ int run_render(const render_options& opt) {
       j["auto_image_variance_edges"] = noise->edge_variance;
       j["auto_edge_noise_factor"] = edge_factor;
       j["auto_albedo"] = std::sqrt(noise->mean_albedo2);
+      nlohmann::ordered_json lights = nlohmann::ordered_json::array();
+      for (const auto_light_settlement& a : settlements)
+        lights.push_back({{"light", a.light},
+                          {"gain_factor", a.kappa},
+                          {"noise_share", a.noise_share},
+                          {"noise_share_measured", a.noise_share_measured},
+                          {"noise_share_model", a.noise_share_model},
+                          {"image_variance", a.image_variance},
+                          {"rest_cost", a.rest_cost},
+                          {"cheapest", a.cheapest}});
+      j["auto_lights"] = lights;
     }
     write_text(opt.stats, j.dump(2) + "\n");
   }

@@ -25,6 +25,7 @@
 #include "mcrt/render/mis.hpp"
 #include "mcrt/render/mis_integrator.hpp"
 #include "mcrt/render/noise_pilot.hpp"
+#include "mcrt/render/choice_gain_pilot.hpp"
 #include "mcrt/render/mixture_integrator.hpp"
 #include "mcrt/render/nee_integrator.hpp"
 #include "mcrt/render/path.hpp"

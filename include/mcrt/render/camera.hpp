@@ -26,6 +26,20 @@ class camera {
     return {origin_, upper_left_ + s * horizontal_ - t * vertical_ - origin_};
   }
 
+  // The inverse of generate: the image coordinates (s, t) of the point p,
+  // false where p is not in front of the camera (on or behind the plane
+  // through the eye parallel to the image).
+  bool project(const vec3& p, float& s, float& t) const {
+    const vec3 w = glm::normalize(glm::cross(horizontal_, vertical_));  // towards the viewer
+    const vec3 d = p - origin_;
+    const float depth = -glm::dot(d, w);
+    if (!(depth > 0.0f)) return false;
+    const vec3 q = d / depth - (upper_left_ - origin_);  // on the image plane, from its upper-left corner
+    s = glm::dot(q, horizontal_) / glm::dot(horizontal_, horizontal_);
+    t = -glm::dot(q, vertical_) / glm::dot(vertical_, vertical_);
+    return true;
+  }
+
  private:
   vec3 origin_{0.0f}, upper_left_{0.0f}, horizontal_{0.0f}, vertical_{0.0f};
 };

@@ -84,6 +84,25 @@ inline noise_pilot_settings noise_pilot_for(int width, int height, int spp) {
   return {static_cast<int>(std::clamp(budget, 64.0, 1024.0)), 2, 8};
 }
 
+// A pixel sampler that counts the light samples a path draws (its 2-D draws
+// at a bounce's light dimensions, samplers/layout.hpp) and otherwise is the
+// sampler it wraps.
+template <class P>
+struct counting_pixel_sampler {
+  static constexpr bool sequential = P::sequential;
+  P& inner;
+  std::uint64_t& light_samples;
+
+  vec2 pixel() { return inner.pixel(); }
+  float get1d(int dim) { return inner.get1d(dim); }
+  vec2 get2d(int dim) {
+    const int d = dim - layout::bounce(0);
+    if (d >= 0 && d % layout::dims_per_bounce == layout::light) ++light_samples;
+    return inner.get2d(dim);
+  }
+  auto& stream() { return inner.stream(); }
+};
+
 // The radiance a camera ray meets first: the emission of the surface it
 // hits (front side; 0 for a surface that does not emit), or the background.
 template <class Scene>
@@ -91,6 +110,23 @@ color radiance_met_first(const Scene& sc, const ray& r) {
   hit_record rec;
   if (!sc.hit(r, sc.ray_epsilon, infinity, rec)) return sc.background;
   return emitted(sc.materials[rec.material], rec);
+}
+
+// A light sample's estimate of the direct light at p (facing normal nf) over
+// the surface's albedo / pi: the radiance of the emitter's front side the
+// shadow ray meets first (the channels' mean), times cos(theta) / pdf; 0
+// where the light offered no sample (ok false, pdf 0), below the surface, or
+// where the shadow ray meets no emitter's front side. As the integrators'
+// sample_direct_light (render/nee_integrator.hpp) with one light.
+template <class Scene>
+double light_estimate(const Scene& sc, bool ok, const light_sample& ls, const vec3& p, const vec3& nf) {
+  if (!ok || !(ls.pdf > 0.0f) || !std::isfinite(ls.pdf)) return 0.0;
+  const float c = glm::dot(ls.dir, nf);
+  if (!(c > 0.0f)) return 0.0;
+  hit_record srec;
+  if (!sc.hit(ray{p, ls.dir}, sc.ray_epsilon, infinity, srec)) return 0.0;
+  const color le = emitted(sc.materials[srec.material], srec);
+  return (double(le.r) + le.g + le.b) / 3.0 * c / double(ls.pdf);
 }
 
 // The unbiased sample variance of n >= 2 values, averaged over the channels.
@@ -102,8 +138,56 @@ inline double sample_variance(const glm::dvec3* v, int n) {
   return (ss.x + ss.y + ss.z) / (3.0 * (n - 1));
 }
 
-// A pixel of the finer blocks whose K emission rays did not all meet the
-// same radiance (an emitter's edge, most likely), with its block's weight.
+// Points whose convex hull holds the shape (for its footprint in the image).
+inline std::vector<vec3> hull_points(const rect& r) {
+  return {r.corner, r.corner + r.e1, r.corner + r.e2, r.corner + r.e1 + r.e2};
+}
+inline std::vector<vec3> hull_points(const ellipse& e) {
+  return {e.center + e.a1 + e.a2, e.center + e.a1 - e.a2, e.center - e.a1 + e.a2, e.center - e.a1 - e.a2};
+}
+inline std::vector<vec3> hull_points(const sphere& s) {
+  std::vector<vec3> v;
+  for (int i = 0; i < 8; ++i)
+    v.push_back(s.center + s.radius * vec3(i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, i & 4 ? 1.0f : -1.0f));
+  return v;
+}
+
+// The pixels where the camera may see an emitter of the scene's lights: per
+// emitter the bounding rectangle of its hull's projection, one pixel wider
+// on every side; the whole image for an emitter not wholly in front of the
+// camera. A mask of width x height, row order.
+template <class Scene>
+std::vector<std::uint8_t> emitter_footprint(const Scene& sc, const camera& cam, int width, int height) {
+  std::vector<std::uint8_t> mask(static_cast<std::size_t>(width) * height, 0);
+  for (const emitter& em : sc.emitters) {
+    const std::vector<vec3> pts =
+        std::visit([](const auto& l) { return hull_points(l.shape); }, sc.lights[em.light]);
+    float s0 = infinity, s1 = -infinity, t0 = infinity, t1 = -infinity;
+    bool front = true;
+    for (const vec3& p : pts) {
+      float s = 0.0f, t = 0.0f;
+      if (!cam.project(p, s, t)) {
+        front = false;
+        break;
+      }
+      s0 = std::min(s0, s), s1 = std::max(s1, s), t0 = std::min(t0, t), t1 = std::max(t1, t);
+    }
+    int x0 = 0, x1 = width - 1, y0 = 0, y1 = height - 1;
+    if (front) {
+      // Clamped in float first: a point near the eye's plane projects far out.
+      auto to_pixel = [](float v, int n) { return static_cast<int>(std::floor(std::clamp(v * n, -2.0f, n + 2.0f))); };
+      x0 = std::max(0, to_pixel(s0, width) - 1), x1 = std::min(width - 1, to_pixel(s1, width) + 1);
+      y0 = std::max(0, to_pixel(t0, height) - 1), y1 = std::min(height - 1, to_pixel(t1, height) + 1);
+    }
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) mask[static_cast<std::size_t>(y) * width + x] = 1;
+  }
+  return mask;
+}
+
+// A pixel the pilot measured, with its block's weight: of the finer blocks
+// where its K emission rays did not all meet the same radiance (an
+// emitter's edge, most likely), or where its centre sees a receiver.
 struct edge_pixel {
   int x, y;
   double weight;
@@ -117,6 +201,15 @@ struct noise_pilot_result {
   int pixels = 0;               // pixels measured
   int stride = 1;
   std::vector<auto_receiver> receivers;  // the diffuse surfaces the measured pixels' centres see
+  std::vector<edge_pixel> receiver_pixels;  // their pixels, with their blocks' weights (receivers' order)
+  // Per light of the scene: the variance of its own first-bounce estimate
+  // (its sampler's noise alone, with independent samples), mean over the
+  // pixels as V is: radiance^2 per pixel sample (header).
+  std::vector<double> light_variance;
+  // The pilot's paths' time (one thread's) per light sample they took: a
+  // light sample's share of a path's time with the cheapest strategies and
+  // independent samples (0 where they took none).
+  double seconds_per_light_sample = 0.0;
   std::vector<edge_pixel> edge_pixels;   // the finer blocks' pixels with s2_K(E) > 0, in row order
 };
 
@@ -173,41 +266,131 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
   // Per row (the pilot's rows, then the finer grid's), summed in row order
   // afterwards: the result does not depend on which thread took which row
   // (the choices of `auto` depend on it).
-  const int rows = ny + nye;
+  // The emission term's first stratum (header): the pixels where the camera
+  // may see an emitter (emitter_footprint), every one of them measured with
+  // as many rays as the finer blocks take in all (2 to K each), or, where
+  // they are more than half that many rays, a systematic sample of them
+  // with 2 rays each (a random start: each pixel's inclusion probability is
+  // the same, count / size, and its term is weighted by the inverse). The
+  // finer blocks then measure only the pixels outside it.
+  std::vector<std::uint8_t> in_footprint;
+  std::vector<int> footprint;  // y * width + x
+  if (k_rays) {
+    in_footprint = emitter_footprint(sc, cam, rs.width, rs.height);
+    for (std::size_t i = 0; i < in_footprint.size(); ++i)
+      if (in_footprint[i]) footprint.push_back(static_cast<int>(i));
+  }
+  const double rays_f = double(ke_rays) * nxe * nye;
+  std::size_t nf = footprint.size();
+  int kf_rays = 2;
+  double f_weight = 1.0;  // pixels each measured footprint pixel stands for
+  if (nf > 0) {
+    if (2.0 * double(nf) <= rays_f) {
+      kf_rays = std::clamp(static_cast<int>(rays_f / double(nf)), 2, std::max(k_rays, 2));
+    } else {
+      nf = static_cast<std::size_t>(rays_f / 2.0);
+      f_weight = double(footprint.size()) / double(nf);
+    }
+  }
+  auto footprint_pixel = [&](std::size_t i) {
+    auto px = pixel_chooser.start_pixel(0, 0, 1);
+    px.start_sample(1);
+    const double start = double(px.stream().uniform2().x);
+    const auto k = static_cast<std::size_t>((double(i) + start) * f_weight);
+    return footprint[std::min(k, footprint.size() - 1)];
+  };
+  // Outside the footprint a camera ray meets emission only where the
+  // background or an emitter the lights do not list emits; elsewhere the
+  // finer blocks have nothing to measure (every s2_K(E) there is 0).
+  const bool outside = sc.background != color(0.0f) || sc.unsampled_emitters > 0;
+  constexpr std::size_t footprint_chunk = 64;
+  const int nfe = static_cast<int>((nf + footprint_chunk - 1) / footprint_chunk);
+  const int rows = ny + nye + nfe;
   std::atomic<int> next_row{0};
   std::vector<double> row_sums(static_cast<std::size_t>(rows), 0.0), row_weights(static_cast<std::size_t>(rows), 0.0),
       row_albedo2(static_cast<std::size_t>(ny), 0.0);
   std::vector<int> row_counts(static_cast<std::size_t>(ny), 0), row_diffuse(static_cast<std::size_t>(ny), 0);
   std::vector<std::vector<auto_receiver>> row_receivers(static_cast<std::size_t>(ny));
-  std::vector<std::vector<edge_pixel>> row_edges(static_cast<std::size_t>(nye));
+  std::vector<std::vector<edge_pixel>> row_receiver_pixels(static_cast<std::size_t>(ny));
+  const std::size_t nl = sc.lights.size();
+  std::vector<std::vector<double>> row_lights(static_cast<std::size_t>(ny), std::vector<double>(nl, 0.0));
+  std::vector<std::vector<edge_pixel>> row_edges(static_cast<std::size_t>(nye + nfe));
+  const double block_pixels = double(ke) * ke;  // the pixels a finer block's full weight stands for
+  using pilot_pixel_sampler = decltype(sampler.start_pixel(0, 0, 1));
+  std::vector<double> row_path_seconds(static_cast<std::size_t>(ny), 0.0);
+  std::vector<std::uint64_t> row_light_samples(static_cast<std::size_t>(ny), 0);
   auto worker = [&] {
+    std::vector<block_pixel> blocks;
+    std::vector<pilot_pixel_sampler> pixel_samplers;
+    blocks.reserve(static_cast<std::size_t>(nx)), pixel_samplers.reserve(static_cast<std::size_t>(nx));
+    std::vector<ray> path_rays(static_cast<std::size_t>(nx) * m);
+    std::vector<color> path_values(static_cast<std::size_t>(nx) * m);
     std::vector<glm::dvec3> c(static_cast<std::size_t>(m)), e(static_cast<std::size_t>(m)),
-        ek(static_cast<std::size_t>(std::max(ke_rays, 1)));
+        ek(static_cast<std::size_t>(std::max({ke_rays, kf_rays, 1})));
+    // s2_K(E) of pixel (x, y) from n rays.
+    auto emission_variance = [&](int x, int y, int n) {
+      auto px = edge_sampler.start_pixel(x, y, rs.width);
+      px.start_sample(0);
+      for (int r = 0; r < n; ++r)
+        ek[static_cast<std::size_t>(r)] =
+            glm::dvec3(radiance_met_first(sc, pixel_ray(cam, x, y, px.stream().uniform2(), inv_w, inv_h)));
+      return sample_variance(ek.data(), n);
+    };
     for (int j; (j = next_row.fetch_add(1, std::memory_order_relaxed)) < rows;) {
       double sum = 0.0, weights = 0.0;
       int count = 0;
-      if (j >= ny) {
-        // A row of the finer blocks: s2_K(E) of each one's pixel.
-        for (int i = 0; i < nxe; ++i) {
-          const block_pixel b = pick(i, j - ny, ke, nxe, 1);
-          auto px = edge_sampler.start_pixel(b.x, b.y, rs.width);
-          px.start_sample(0);
-          for (int r = 0; r < ke_rays; ++r)
-            ek[static_cast<std::size_t>(r)] =
-                glm::dvec3(radiance_met_first(sc, pixel_ray(cam, b.x, b.y, px.stream().uniform2(), inv_w, inv_h)));
-          const double s2 = sample_variance(ek.data(), ke_rays);
-          if (s2 > 0.0) row_edges[static_cast<std::size_t>(j - ny)].push_back({b.x, b.y, b.weight});
-          sum += b.weight * s2;
-          weights += b.weight;
+      if (j >= ny + nye) {
+        // A chunk of the footprint's pixels (sums in pixels).
+        const std::size_t i0 = static_cast<std::size_t>(j - ny - nye) * footprint_chunk;
+        for (std::size_t i = i0; i < std::min(nf, i0 + footprint_chunk); ++i) {
+          const int p = footprint_pixel(i), x = p % rs.width, y = p / rs.width;
+          const double s2 = emission_variance(x, y, kf_rays);
+          if (s2 > 0.0) row_edges[static_cast<std::size_t>(j - ny)].push_back({x, y, f_weight});
+          sum += f_weight * s2;
         }
         row_sums[static_cast<std::size_t>(j)] = sum;
-        row_weights[static_cast<std::size_t>(j)] = weights;
+        continue;
+      }
+      if (j >= ny) {
+        // A row of the finer blocks: s2_K(E) of each one's pixel, outside
+        // the footprint (sums in pixels).
+        for (int i = 0; i < nxe && outside; ++i) {
+          const block_pixel b = pick(i, j - ny, ke, nxe, 1);
+          if (!in_footprint.empty() && in_footprint[static_cast<std::size_t>(b.y) * rs.width + b.x]) continue;
+          const double s2 = emission_variance(b.x, b.y, ke_rays);
+          if (s2 > 0.0) row_edges[static_cast<std::size_t>(j - ny)].push_back({b.x, b.y, b.weight * block_pixels});
+          sum += b.weight * block_pixels * s2;
+        }
+        row_sums[static_cast<std::size_t>(j)] = sum;
         continue;
       }
       double albedo2 = 0.0;
       int diffuse = 0;
+      // The row's paths first, timed apart from the rest of the pilot's
+      // work, counting their light samples (the time per light sample).
+      blocks.clear(), pixel_samplers.clear();
       for (int i = 0; i < nx; ++i) {
-        const block_pixel b = pick(i, j, k, nx, 0);
+        blocks.push_back(pick(i, j, k, nx, 0));
+        pixel_samplers.push_back(sampler.start_pixel(blocks.back().x, blocks.back().y, rs.width));
+      }
+      std::uint64_t light_samples = 0;
+      const auto paths_start = std::chrono::steady_clock::now();
+      for (int i = 0; i < nx; ++i) {
+        auto& px = pixel_samplers[static_cast<std::size_t>(i)];
+        counting_pixel_sampler<pilot_pixel_sampler> counted{px, light_samples};
+        for (int s = 0; s < m; ++s) {
+          px.start_sample(s);
+          const ray r = camera_ray(cam, px, blocks[static_cast<std::size_t>(i)].x, blocks[static_cast<std::size_t>(i)].y,
+                                   inv_w, inv_h);
+          path_rays[static_cast<std::size_t>(i * m + s)] = r;
+          path_values[static_cast<std::size_t>(i * m + s)] = Integrator::li(sc, r, counted, set);
+        }
+      }
+      row_path_seconds[static_cast<std::size_t>(j)] =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - paths_start).count();
+      row_light_samples[static_cast<std::size_t>(j)] = light_samples;
+      for (int i = 0; i < nx; ++i) {
+        const block_pixel b = blocks[static_cast<std::size_t>(i)];
         const int x = b.x, y = b.y;
         // The surface at the pixel's centre: its albedo, if diffuse.
         hit_record rec;
@@ -217,17 +400,39 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
             albedo2 += a * a;
             ++diffuse;
             row_receivers[static_cast<std::size_t>(j)].push_back({rec.p, rec.facing_normal()});
+            row_receiver_pixels[static_cast<std::size_t>(j)].push_back({x, y, b.weight});
           }
-        auto px = sampler.start_pixel(x, y, rs.width);
+        auto& px = pixel_samplers[static_cast<std::size_t>(i)];
         int finite = 0;
         for (int s = 0; s < m; ++s) {
-          px.start_sample(s);
-          const ray r = camera_ray(cam, px, x, y, inv_w, inv_h);
-          const color v = Integrator::li(sc, r, px, set);
+          const ray r = path_rays[static_cast<std::size_t>(i * m + s)];
+          const color v = path_values[static_cast<std::size_t>(i * m + s)];
           if (!all_finite(v)) continue;
           c[static_cast<std::size_t>(finite)] = glm::dvec3(v);
           if (k_rays) e[static_cast<std::size_t>(finite)] = glm::dvec3(radiance_met_first(sc, r));
           ++finite;
+          // Each light's own noise at the surface the camera ray meets:
+          // two independent samples of it there, (f1 - f2)^2 / 2 (its
+          // variance given the point), over P(light) as the estimator
+          // divides by it.
+          if (nl == 0 || s > 0) continue;  // at the first sample's point of each pixel
+          hit_record rec1;
+          if (!sc.hit(r, sc.ray_epsilon, infinity, rec1)) continue;
+          const auto* lam = std::get_if<lambertian>(&sc.materials[rec1.material]);
+          if (!lam) continue;
+          const vec3 nf = rec1.facing_normal();
+          const light_selection sel(sc, rec1.p, nf, set.choose);
+          const double a = (double(lam->albedo.r) + lam->albedo.g + lam->albedo.b) / 3.0 * inv_pi;
+          for (std::size_t l = 0; l < nl; ++l) {
+            const double prob = sel.probability(l);
+            if (!(prob > 0.0)) continue;
+            light_sample s1, s2;
+            const bool ok1 = sample(sc.lights[l], rec1.p, nf, px.stream().uniform2(), s1);
+            const double f1 = light_estimate(sc, ok1, s1, rec1.p, nf);
+            const bool ok2 = sample(sc.lights[l], rec1.p, nf, px.stream().uniform2(), s2);
+            const double f2 = light_estimate(sc, ok2, s2, rec1.p, nf);
+            row_lights[static_cast<std::size_t>(j)][l] += b.weight * a * a * 0.5 * (f1 - f2) * (f1 - f2) / prob;
+          }
         }
         if (finite < 2) continue;
         // What the camera rays meet first taken out of each sample (its
@@ -253,20 +458,31 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
     worker();
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  double sum = 0.0, weights = 0.0, albedo2 = 0.0, edge_sum = 0.0, edge_weights = 0.0;
+  double sum = 0.0, weights = 0.0, albedo2 = 0.0, edge_sum = 0.0;
   int diffuse = 0;
   for (std::size_t j = 0; j < static_cast<std::size_t>(ny); ++j) {
     sum += row_sums[j], weights += row_weights[j], out.pixels += row_counts[j];
     albedo2 += row_albedo2[j], diffuse += row_diffuse[j];
     out.receivers.insert(out.receivers.end(), row_receivers[j].begin(), row_receivers[j].end());
+    out.receiver_pixels.insert(out.receiver_pixels.end(), row_receiver_pixels[j].begin(),
+                               row_receiver_pixels[j].end());
+    out.light_variance.resize(nl, 0.0);
+    for (std::size_t l = 0; l < nl; ++l) out.light_variance[l] += row_lights[j][l];
   }
   for (std::size_t j = static_cast<std::size_t>(ny); j < static_cast<std::size_t>(rows); ++j) {
-    edge_sum += row_sums[j], edge_weights += row_weights[j];
+    edge_sum += row_sums[j];
     const auto& edges = row_edges[j - static_cast<std::size_t>(ny)];
     out.edge_pixels.insert(out.edge_pixels.end(), edges.begin(), edges.end());
   }
-  out.edge_variance = edge_weights > 0.0 ? edge_sum / edge_weights : 0.0;
+  out.edge_variance = edge_sum / (double(rs.width) * rs.height);
   if (weights > 0.0) out.image_variance = sum / weights + out.edge_variance;
+  out.light_variance.resize(nl, 0.0);
+  for (double& v : out.light_variance) v = weights > 0.0 ? v / weights : 0.0;
+  double path_seconds = 0.0;
+  std::uint64_t light_samples = 0;
+  for (std::size_t j = 0; j < static_cast<std::size_t>(ny); ++j)
+    path_seconds += row_path_seconds[j], light_samples += row_light_samples[j];
+  if (light_samples > 0) out.seconds_per_light_sample = path_seconds / double(light_samples);
   if (diffuse > 0) out.mean_albedo2 = albedo2 / diffuse;
   return out;
 }
