@@ -190,8 +190,9 @@ int run_render(const render_options& opt) {
       for (const auto_light_settlement& a : settlements)
         lights.push_back({{"light", a.light},
                           {"gain_factor", a.kappa},
-                          {"light_variance", a.light_variance},
-                          {"other_variance", a.other_variance},
+                          {"noise_share", a.noise_share},
+                          {"noise_share_measured", a.noise_share_measured},
+                          {"noise_share_model", a.noise_share_model},
                           {"image_variance", a.image_variance},
                           {"rest_cost", a.rest_cost},
                           {"cheapest", a.cheapest}});

@@ -36,26 +36,17 @@
 // receiver the choice samples by a dearer strategy (elsewhere d = 0), at
 // most `pixels` of them, evenly spaced.
 //
-// The image's noise with the image's samples: the pilot splits V into
-// V_L, each light's own noise with its cheapest strategy (two light samples
-// at a pixel's first point: noise_pilot_result::light_variance), and V_O,
-// the rest (V of the paths without their first light sample, the emission
-// term scaled by kappa_E: other_variance). The image's samples leave kappa
-// V_L of the first (kappa measured on that light's choice, taken for its
-// own noise), and the rest is left at its independent size (an
-// overestimate: the choice is weighed against more noise than the image
-// has, never less). The choice gains kappa of what the rule models, so the
-// rule of light l sees
-//   V_l = (kappa V_L + V_O') / kappa = V_L + V_O' / kappa
-// (auto_params::image_variance), V_O' = V_O plus the other lights' V_L:
-// its scores v_s / v_rest = kappa D^2 v_s / (kappa V_L + V_O') are the
+// The light's own noise with its cheapest strategy is a share s of V (the
+// pilot's light_variance over V), and the image's samples leave kappa of
+// it: the image's noise is V (1 - (1 - kappa) s), and the choice gains
+// kappa of what the rule models. The rule of the light then sees
+// V_l = V (1 - (1 - kappa) s) / kappa (auto_params::image_variance): its
+// scores v_s / v_rest = kappa D^2 v_s / (V (1 - (1 - kappa) s)) are the
 // modelled gains with the image's samples against the image's noise with
-// them. Where the light's noise is all of the image's (a floor close under
-// a light) V_l = V_L, V as before; where it is little of it (a box whose
-// light the camera sees) V_l approaches V_O / kappa. V_O leaves out the
-// light's own noise, which is heavy-tailed where a receiver is close to a
-// light (area sampling's 1 / r^2): a ratio V_L / V from two such estimates
-// varied 0.1-1.7 between seeds over a floor at 0.3 light sizes.
+// them. V <= V_l <= V / kappa: V where the light's noise is all of the
+// image's, V / kappa where it is none of it. The path's noise beyond the
+// light's is left at its independent size: an overestimate, so the choice
+// is weighed against more noise than the image has, never less.
 //
 // The pixels' light samples are the first bounce's; with global light a
 // light sample at a deeper bounce sits on dimensions the sequence
@@ -162,8 +153,8 @@ double choice_gain_factor(const Scene& sc, const camera& cam, const render_setti
 struct auto_light_settlement {
   std::size_t light = 0;        // index in the scene's lights
   double kappa = 1.0;           // what the image's samples leave of the choice's gain (header)
-  double light_variance = 0.0;  // V_L: its own noise with its cheapest strategy (the pilot's)
-  double other_variance = 0.0;  // V_O plus the other lights' V_L: the rest of the image's noise
+  double noise_share = 0.0;     // s: the light's own noise with its cheapest strategy, over V
+  double noise_share_measured = 0.0, noise_share_model = 0.0;
   double image_variance = 0.0;  // V_l: the V its rule sees
   double rest_cost = 0.0;       // c_rest its rule took, ns per light sample
   bool cheapest = false;        // its choice did not pay at the receivers: its cheapest strategy everywhere
@@ -193,19 +184,10 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
             if (measure_rest_cost && noise.seconds_per_light_sample > 0.0)
               p.rest_cost = std::max(0.0f, float(noise.seconds_per_light_sample * 1e9) - s.cheapest_cost());
             a.rest_cost = p.rest_cost;
-            a.light_variance = i < noise.light_variance.size() ? noise.light_variance[i] : 0.0;
-            a.other_variance = std::max(noise.other_variance, 0.0);
-            for (std::size_t j = 0; j < noise.light_variance.size(); ++j)
-              if (j != i) a.other_variance += noise.light_variance[j];
-            // V's two parts (V itself where neither was measured), the V_l of
-            // kappa = 1.
-            if (a.light_variance + a.other_variance > 0.0)
-              p.image_variance = static_cast<float>(a.light_variance + a.other_variance);
-            a.image_variance = p.image_variance;
             const S with_cost(s.shape, p);
-            // kappa <= 1 only weighs the choice's gain down (V_l >= V_L +
-            // V_O): where the choice does not pay with kappa = 1, it is not
-            // measured.
+            a.image_variance = p.image_variance;
+            // kappa <= 1 only weighs the choice's gain down (V_l >= V): where
+            // the choice does not pay with V, it is not measured.
             if (!(with_cost.table_gain(noise.receivers) > 0.0f)) {
               rebuilt = with_cost;
               return;
@@ -218,10 +200,13 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
             std::vector<edge_pixel> chosen;
             for (std::size_t k = 0; k < count; ++k) chosen.push_back(dearer[k * dearer.size() / count]);
             a.kappa = choice_gain_factor(sc, cam, rs, with_cost, chosen);
-            // V_l = V_L + (V_O + the other lights' V_L) / kappa (header).
-            if (a.light_variance + a.other_variance > 0.0)
-              a.image_variance = a.kappa > 0.0 ? a.light_variance + a.other_variance / a.kappa
-                                               : double(std::numeric_limits<float>::max());
+            const double v = s.params.image_variance;
+            const double measured = i < noise.light_variance.size() && v > 0.0 ? noise.light_variance[i] / v : 0.0;
+            a.noise_share_measured = measured;
+            a.noise_share_model = s.noise_share(noise.receivers);
+            a.noise_share = std::clamp(std::max(measured, a.noise_share_model), 0.0, 1.0);
+            a.image_variance = a.kappa > 0.0 ? v * (1.0 - (1.0 - a.kappa) * a.noise_share) / a.kappa
+                                             : double(std::numeric_limits<float>::max());
             p.image_variance = static_cast<float>(std::min(a.image_variance, double(std::numeric_limits<float>::max())));
             rebuilt = S(s.shape, p);
           }

@@ -33,18 +33,9 @@
 // carry most of the image's variance where the camera sees a light (with
 // a fixed grid of every stride-th pixel, V differed 1000-fold between the
 // 400- and the 1024-pixel pilots of the Cornell box with the seed's
-// light). So the mean of s2_K(E) is taken over two strata: the emitters'
-// footprint in the image (emitter_footprint: where a camera ray may meet a
-// listed light), every pixel of it measured with 2 to K rays (a
-// systematic sample of it where it is large), and the rest of the image on
-// blocks of half the side (rounded up), one random pixel each, where only
-// an emitting background or an emitter the lights do not list can add
-// anything (else it is not measured). From random pixels of the finer
-// blocks alone (before commit 79f8d0d) the pilot met 0 to 5 edge pixels of
-// a ceiling light in view and V varied 6000-fold between seeds
-// (size_rect_1of4, direct, 100 x 100, 8 and 32 spp: 0.00016 to 1.08);
-// with the footprint it meets 8 to 11 of them, and V is 0.48 to 0.80.
-// Both terms are unbiased and
+// light), so s2_K(E) is measured on blocks of half the side (rounded up),
+// four times as many pixels, with the same number of rays in all (K
+// pixels / pixels_E per pixel, at least 2). Both terms are unbiased and
 // never negative; their sum falls short of the variance of X by the mean
 // of 2 cov(E, R) over a pixel, small where E and R do not vary together (a
 // light's edge: where a ray meets the emitter it reflects nothing). The
@@ -58,19 +49,7 @@
 // The diffuse surfaces the pixels' centres see are kept too (in pixel
 // order, whichever thread met them), as the receivers at which `auto`
 // weighs what its per-point choice gains against what it costs
-// (auto_sampler::table_gain), with their pixels (for
-// render/choice_gain_pilot.hpp).
-//
-// Each light's own noise: at the point the first of a pixel's samples
-// meets, if diffuse, two more independent samples of each light give
-// (f1 - f2)^2 / 2 (with albedo / pi, over the light's choice probability),
-// an unbiased estimate of the variance one light sample adds there; its
-// mean over the blocks, as V's, is light_variance, the light's part of V
-// with its sampler (render/choice_gain_pilot.hpp). And the paths' time:
-// each row's paths are timed apart from the rest of the pilot, their light
-// samples counted (counting_pixel_sampler); seconds_per_light_sample, the
-// time per light sample with the cheapest strategies and independent
-// samples, gives `auto` its c_rest.
+// (auto_sampler::table_gain).
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -78,7 +57,6 @@
 #include <cstdint>
 #include <span>
 #include <thread>
-#include <type_traits>
 #include <variant>
 #include <vector>
 
@@ -106,54 +84,24 @@ inline noise_pilot_settings noise_pilot_for(int width, int height, int spp) {
   return {static_cast<int>(std::clamp(budget, 64.0, 1024.0)), 2, 8};
 }
 
-// The draws of a path's first light sample (its light choice and its point
-// of the square), as recording_pixel_sampler saw them; drawn is false where
-// the path took none (no diffuse first surface, or no light offers one).
-struct first_light_draws {
-  float choice = 0.0f;
-  vec2 u{0.0f};
-  bool drawn = false;
-  // As a pixel sampler for sample_direct_light (nee_integrator.hpp): the
-  // same draws again, so the same light sample.
-  float get1d(int /*dim*/) const { return choice; }
-  vec2 get2d(int /*dim*/) const { return u; }
-};
-
 // A pixel sampler that counts the light samples a path draws (its 2-D draws
-// at a bounce's light dimensions, samplers/layout.hpp) and records the
-// first bounce's, and otherwise is the sampler it wraps.
+// at a bounce's light dimensions, samplers/layout.hpp) and otherwise is the
+// sampler it wraps.
 template <class P>
-struct recording_pixel_sampler {
+struct counting_pixel_sampler {
   static constexpr bool sequential = P::sequential;
   P& inner;
   std::uint64_t& light_samples;
-  first_light_draws& first;
 
   vec2 pixel() { return inner.pixel(); }
-  float get1d(int dim) {
-    const float v = inner.get1d(dim);
-    if (dim == layout::bounce(0) + layout::light_choice) first.choice = v;
-    return v;
-  }
+  float get1d(int dim) { return inner.get1d(dim); }
   vec2 get2d(int dim) {
-    const vec2 v = inner.get2d(dim);
     const int d = dim - layout::bounce(0);
-    if (d >= 0 && d % layout::dims_per_bounce == layout::light) {
-      ++light_samples;
-      if (d == layout::light) first.u = v, first.drawn = true;
-    }
-    return v;
+    if (d >= 0 && d % layout::dims_per_bounce == layout::light) ++light_samples;
+    return inner.get2d(dim);
   }
   auto& stream() { return inner.stream(); }
 };
-
-// The weights of a next-event integrator (nee, mis: render/nee_integrator.hpp),
-// void for one without a separate light sample (the mixture).
-template <class W>
-W light_weights_of(const next_event_integrator<W>*);
-void light_weights_of(const void*);
-template <class Integrator>
-using light_weights_t = decltype(light_weights_of(static_cast<const Integrator*>(nullptr)));
 
 // The radiance a camera ray meets first: the emission of the surface it
 // hits (front side; 0 for a surface that does not emit), or the background.
@@ -258,10 +206,6 @@ struct noise_pilot_result {
   // (its sampler's noise alone, with independent samples), mean over the
   // pixels as V is: radiance^2 per pixel sample (header).
   std::vector<double> light_variance;
-  // V without the paths' first light samples (header): the rest of the
-  // image's noise, the emission term included; for the mixture, which
-  // takes no separate light sample, V's own terms.
-  double other_variance = 0.0;
   // The pilot's paths' time (one thread's) per light sample they took: a
   // light sample's share of a path's time with the cheapest strategies and
   // independent samples (0 where they took none).
@@ -373,7 +317,7 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
   std::vector<std::vector<edge_pixel>> row_edges(static_cast<std::size_t>(nye + nfe));
   const double block_pixels = double(ke) * ke;  // the pixels a finer block's full weight stands for
   using pilot_pixel_sampler = decltype(sampler.start_pixel(0, 0, 1));
-  std::vector<double> row_path_seconds(static_cast<std::size_t>(ny), 0.0), row_other(static_cast<std::size_t>(ny), 0.0);
+  std::vector<double> row_path_seconds(static_cast<std::size_t>(ny), 0.0);
   std::vector<std::uint64_t> row_light_samples(static_cast<std::size_t>(ny), 0);
   auto worker = [&] {
     std::vector<block_pixel> blocks;
@@ -381,8 +325,7 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
     blocks.reserve(static_cast<std::size_t>(nx)), pixel_samplers.reserve(static_cast<std::size_t>(nx));
     std::vector<ray> path_rays(static_cast<std::size_t>(nx) * m);
     std::vector<color> path_values(static_cast<std::size_t>(nx) * m);
-    std::vector<first_light_draws> path_draws(static_cast<std::size_t>(nx) * m);
-    std::vector<glm::dvec3> c(static_cast<std::size_t>(m)), o(static_cast<std::size_t>(m)), e(static_cast<std::size_t>(m)),
+    std::vector<glm::dvec3> c(static_cast<std::size_t>(m)), e(static_cast<std::size_t>(m)),
         ek(static_cast<std::size_t>(std::max({ke_rays, kf_rays, 1})));
     // s2_K(E) of pixel (x, y) from n rays.
     auto emission_variance = [&](int x, int y, int n) {
@@ -421,7 +364,7 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
         row_sums[static_cast<std::size_t>(j)] = sum;
         continue;
       }
-      double albedo2 = 0.0, other = 0.0;
+      double albedo2 = 0.0;
       int diffuse = 0;
       // The row's paths first, timed apart from the rest of the pilot's
       // work, counting their light samples (the time per light sample).
@@ -434,10 +377,8 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
       const auto paths_start = std::chrono::steady_clock::now();
       for (int i = 0; i < nx; ++i) {
         auto& px = pixel_samplers[static_cast<std::size_t>(i)];
+        counting_pixel_sampler<pilot_pixel_sampler> counted{px, light_samples};
         for (int s = 0; s < m; ++s) {
-          first_light_draws& first = path_draws[static_cast<std::size_t>(i * m + s)];
-          first = {};
-          recording_pixel_sampler<pilot_pixel_sampler> counted{px, light_samples, first};
           px.start_sample(s);
           const ray r = camera_ray(cam, px, blocks[static_cast<std::size_t>(i)].x, blocks[static_cast<std::size_t>(i)].y,
                                    inv_w, inv_h);
@@ -468,29 +409,19 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
           const color v = path_values[static_cast<std::size_t>(i * m + s)];
           if (!all_finite(v)) continue;
           c[static_cast<std::size_t>(finite)] = glm::dvec3(v);
-          o[static_cast<std::size_t>(finite)] = glm::dvec3(v);
           if (k_rays) e[static_cast<std::size_t>(finite)] = glm::dvec3(radiance_met_first(sc, r));
           ++finite;
-          if (nl == 0) continue;
+          // Each light's own noise at the surface the camera ray meets:
+          // two independent samples of it there, (f1 - f2)^2 / 2 (its
+          // variance given the point), over P(light) as the estimator
+          // divides by it.
+          if (nl == 0 || s > 0) continue;  // at the first sample's point of each pixel
           hit_record rec1;
           if (!sc.hit(r, sc.ray_epsilon, infinity, rec1)) continue;
           const auto* lam = std::get_if<lambertian>(&sc.materials[rec1.material]);
           if (!lam) continue;
           const vec3 nf = rec1.facing_normal();
           const light_selection sel(sc, rec1.p, nf, set.choose);
-          // The sample without its first light sample (header): the same
-          // draws give the same light sample again.
-          if constexpr (!std::is_void_v<light_weights_t<Integrator>>) {
-            first_light_draws& first = path_draws[static_cast<std::size_t>(i * m + s)];
-            if (first.drawn)
-              o[static_cast<std::size_t>(finite - 1)] -= glm::dvec3(sample_direct_light<light_weights_t<Integrator>>(
-                  sc, rec1.p, nf, lam->albedo, sel, first, layout::bounce(0), set));
-          }
-          // Each light's own noise at the surface the camera ray meets:
-          // two independent samples of it there, (f1 - f2)^2 / 2 (its
-          // variance given the point), over P(light) as the estimator
-          // divides by it.
-          if (s > 0) continue;  // at the first sample's point of each pixel
           const double a = (double(lam->albedo.r) + lam->albedo.g + lam->albedo.b) / 3.0 * inv_pi;
           for (std::size_t l = 0; l < nl; ++l) {
             const double prob = sel.probability(l);
@@ -507,16 +438,12 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
         // What the camera rays meet first taken out of each sample (its
         // variance comes from the finer blocks: header).
         if (k_rays)
-          for (int i = 0; i < finite; ++i)
-            c[static_cast<std::size_t>(i)] -= e[static_cast<std::size_t>(i)],
-                o[static_cast<std::size_t>(i)] -= e[static_cast<std::size_t>(i)];
+          for (int i = 0; i < finite; ++i) c[static_cast<std::size_t>(i)] -= e[static_cast<std::size_t>(i)];
         sum += b.weight * sample_variance(c.data(), finite);
-        other += b.weight * sample_variance(o.data(), finite);
         weights += b.weight;
         ++count;
       }
       row_sums[static_cast<std::size_t>(j)] = sum;
-      row_other[static_cast<std::size_t>(j)] = other;
       row_weights[static_cast<std::size_t>(j)] = weights;
       row_counts[static_cast<std::size_t>(j)] = count;
       row_albedo2[static_cast<std::size_t>(j)] = albedo2;
@@ -553,10 +480,8 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
   for (double& v : out.light_variance) v = weights > 0.0 ? v / weights : 0.0;
   double path_seconds = 0.0;
   std::uint64_t light_samples = 0;
-  double other = 0.0;
   for (std::size_t j = 0; j < static_cast<std::size_t>(ny); ++j)
-    path_seconds += row_path_seconds[j], light_samples += row_light_samples[j], other += row_other[j];
-  if (weights > 0.0) out.other_variance = other / weights + out.edge_variance;
+    path_seconds += row_path_seconds[j], light_samples += row_light_samples[j];
   if (light_samples > 0) out.seconds_per_light_sample = path_seconds / double(light_samples);
   if (diffuse > 0) out.mean_albedo2 = albedo2 / diffuse;
   return out;
@@ -571,11 +496,9 @@ noise_pilot_result estimate_image_variance(const Scene& sc, const camera& cam, c
 }
 
 // The pilot's result with its emission term as the image's samples leave
-// it (kappa_E from edge_noise_factor below): V, its rest beyond the first
-// light samples, and its emission term.
+// it (kappa_E from edge_noise_factor below): V and its emission term.
 inline void scale_emission_term(noise_pilot_result& r, double kappa_e) {
   r.image_variance -= (1.0 - kappa_e) * r.edge_variance;
-  r.other_variance -= (1.0 - kappa_e) * r.edge_variance;
   r.edge_variance *= kappa_e;
 }
 

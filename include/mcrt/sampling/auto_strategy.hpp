@@ -607,6 +607,13 @@ class tabulated_planar_rule {
            m.score_of(choose(o, n), auto_costs::table_lookup, c, params_);
   }
   light_sampling cheapest() const { return auto_choice::cheapest(rule_.costs()); }
+  // The light's own noise at (o, n) with its cheapest strategy (area
+  // sampling), relative to the image's: v_area / v_rest = D^2 v_area / V,
+  // its share of V at the point (the fine rule's; 0 where it gives nothing).
+  float noise_share(const vec3& o, const vec3& n) const {
+    const auto_choice m = rule_.fine(o, n);
+    return m.v_area() / m.rest_variance(params_);
+  }
   float cheapest_cost() const {
     const auto_costs::shape_costs& c = rule_.costs();
     return std::min({c.area, c.solid_angle, c.projected_solid_angle});
@@ -639,6 +646,11 @@ class tabulated_sphere_rule {
   }
   // The same above the horizon and across it.
   light_sampling cheapest() const { return auto_choice::cheapest(auto_costs::sphere_above); }
+  // As tabulated_planar_rule::noise_share, with the cone (v_sa).
+  float noise_share(const vec3& o, const vec3& n) const {
+    const auto_choice m = auto_model(sphere_, o, n);
+    return m.v_solid_angle() / m.rest_variance(params_);
+  }
   float cheapest_cost() const {
     const auto_costs::shape_costs& c = auto_costs::sphere_above;
     return std::min({c.area, c.solid_angle, c.projected_solid_angle});
@@ -700,6 +712,16 @@ struct auto_sampler {
   light_sampling cheapest() const { return rule_.cheapest(); }
   // Its modelled cost per light sample (auto_costs, ns).
   float cheapest_cost() const { return rule_.cheapest_cost(); }
+  // The light's own share of the image's noise V with its cheapest
+  // strategy, as modelled (independent samples): the mean over the
+  // receivers rs of D^2 v_cheapest / V (the rules' noise_share). Defined
+  // where v_rest comes from the image's noise; 0 otherwise.
+  float noise_share(std::span<const auto_receiver> rs) const {
+    if (!(params.image_variance > 0.0f) || rs.empty()) return 0.0f;
+    double sum = 0.0;
+    for (const auto_receiver& r : rs) sum += rule_.noise_share(r.p, r.n);
+    return static_cast<float>(sum / double(rs.size()));
+  }
   // Its sample (the choice's, where the choice is the cheapest strategy).
   bool sample_cheapest(const vec3& o, vec2 u, light_sample& s) const {
     return cheapest() == light_sampling::area ? area.sample(o, u, s) : solid_angle.sample(o, u, s);
