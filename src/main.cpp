@@ -190,6 +190,7 @@ int run_render(const render_options& opt) {
       for (const auto_light_settlement& a : settlements)
         lights.push_back({{"light", a.light},
                           {"gain_factor", a.kappa},
+                          {"gain_factor_first_bounce", a.kappa_first_bounce},
                           {"noise_share", a.noise_share},
                           {"noise_share_measured", a.noise_share_measured},
                           {"noise_share_model", a.noise_share_model},
