@@ -15,31 +15,14 @@
 #include <vector>
 
 #include "mcrt/mcrt.hpp"
+#include "pilot_fixtures.hpp"
 
 using namespace mcrt;
+using mcrt_test::lit_floor;
+using mcrt_test::settings;
 
 namespace {
 
-// A diffuse floor under a rectangular light, a small sphere casting a shadow.
-scene lit_floor() {
-  scene sc;
-  sc.materials = {lambertian{color(0.5f)}, diffuse_light{color(4.0f)}};
-  sc.add(xz_rect_shape{-50, 50, -50, 50, 0}, 0);
-  sc.add(sphere{{0.3f, 0.15f, 0.1f}, 0.15f}, 0);
-  sc.add_light(rect_area_sampler{xz_rect(-0.6f, 0.6f, -0.4f, 0.4f, 0.8f, true)}, 1);
-  sc.ray_epsilon = 1e-4f;
-  return sc;
-}
-
-render_settings settings(int w, int h) {
-  render_settings rs;
-  rs.width = w;
-  rs.height = h;
-  rs.max_depth = 1;
-  rs.integrator = integrator_kind::nee;
-  rs.threads = 2;
-  return rs;
-}
 
 // The two strategies kappa compares, for a rectangle: area sampling (the
 // cheapest) and projected solid angle (the choice), as auto_sampler offers

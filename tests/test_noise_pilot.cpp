@@ -17,38 +17,11 @@
 #include <vector>
 
 #include "mcrt/mcrt.hpp"
+#include "pilot_fixtures.hpp"
 
 using namespace mcrt;
-
-namespace {
-
-// A diffuse floor under a rectangular light, seen from above at an angle;
-// a small sphere casts a shadow.
-scene lit_floor(bool projected) {
-  scene sc;
-  sc.materials = {lambertian{color(0.5f)}, diffuse_light{color(4.0f)}};
-  sc.add(xz_rect_shape{-50, 50, -50, 50, 0}, 0);
-  sc.add(sphere{{0.3f, 0.15f, 0.1f}, 0.15f}, 0);
-  const rect r = xz_rect(-0.6f, 0.6f, -0.4f, 0.4f, 0.8f, true);
-  if (projected)
-    sc.add_light(rect_projected_solid_angle_sampler{r}, 1);
-  else
-    sc.add_light(rect_area_sampler{r}, 1);
-  sc.ray_epsilon = 1e-4f;
-  return sc;
-}
-
-render_settings settings(int w, int h) {
-  render_settings rs;
-  rs.width = w;
-  rs.height = h;
-  rs.max_depth = 1;
-  rs.integrator = integrator_kind::nee;
-  rs.threads = 2;
-  return rs;
-}
-
-}  // namespace
+using mcrt_test::lit_floor;
+using mcrt_test::settings;
 
 TEST(NoisePilot, StrideGivesAboutThePixelsAskedAndTheAlbedoSeen) {
   EXPECT_EQ(noise_pilot_stride(100, 100, 1024), 3);
