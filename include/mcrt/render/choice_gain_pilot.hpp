@@ -62,8 +62,6 @@
 // strip light of the mixed scene (cornell_two_lights, global light) got
 // V_l = 6 V and area sampling, 0.36x the best fixed strategy.
 #include <algorithm>
-#include <atomic>
-#include <thread>
 #include <cstdint>
 #include <span>
 #include <variant>
@@ -93,58 +91,21 @@ inline int choice_gain_pixels_for(int width, int height) {
 template <class Sampler, class Scene, class Auto>
 double choice_gain_factor_with(const Scene& sc, const camera& cam, const render_settings& rs, const Auto& s,
                                std::span<const edge_pixel> pixels, std::uint64_t seed, int scramblings = 2) {
-  const int m = std::max(scramblings, 2), n = std::max(rs.spp, 1);
-  std::vector<Sampler> samplers;
-  for (int j = 0; j < m; ++j) samplers.emplace_back(mix64(seed) + std::uint64_t(j), n);
   const float inv_w = 1.0f / static_cast<float>(rs.width), inv_h = 1.0f / static_cast<float>(rs.height);
   constexpr int dim = layout::bounce(0) + layout::light;
-  // Per pixel, its terms of both sums, summed in pixel order afterwards (the
-  // result does not depend on the threads), on up to rs.threads threads.
-  std::vector<double> between_x(pixels.size(), 0.0), within_x(pixels.size(), 0.0);
-  std::atomic<std::size_t> next{0};
-  auto worker = [&] {
-    std::vector<glm::dvec3> means(static_cast<std::size_t>(m)), d(static_cast<std::size_t>(m) * n);
-    for (std::size_t xi; (xi = next.fetch_add(1, std::memory_order_relaxed)) < pixels.size();) {
-      const edge_pixel& x = pixels[xi];
-      for (int j = 0; j < m; ++j) {
-        auto px = samplers[static_cast<std::size_t>(j)].start_pixel(x.x, x.y, rs.width);
-        double sum = 0.0;
-        for (int k = 0; k < n; ++k) {
-          px.start_sample(k);
-          const ray r = camera_ray(cam, px, x.x, x.y, inv_w, inv_h);
-          double v = 0.0;
-          hit_record rec;
-          if (sc.hit(r, sc.ray_epsilon, infinity, rec))
-            if (const auto* lam = std::get_if<lambertian>(&sc.materials[rec.material])) {
-              const vec3 nf = rec.facing_normal();
-              const vec2 u = px.get2d(dim);
-              light_sample lc, la;
-              const double fc = light_estimate(sc, s.sample_cheapest(rec.p, u, lc), lc, rec.p, nf);
-              const double fa = light_estimate(sc, s.sample(rec.p, nf, u, la), la, rec.p, nf);
-              v = (double(lam->albedo.r) + lam->albedo.g + lam->albedo.b) / 3.0 * inv_pi * (fc - fa);
-            }
-          // One channel in all three: sample_variance averages over channels.
-          d[static_cast<std::size_t>(j) * n + k] = glm::dvec3(v);
-          sum += v;
-        }
-        means[static_cast<std::size_t>(j)] = glm::dvec3(sum / n);
-      }
-      between_x[xi] = x.weight * double(n) * sample_variance(means.data(), m);
-      within_x[xi] = x.weight * sample_variance(d.data(), m * n);
-    }
-  };
-  // A second thread where the pixels' samples are many enough to pay for
-  // starting it (about 0.1 ms: 512 camera samples or more).
-  unsigned threads = rs.threads ? rs.threads : std::max(1u, std::thread::hardware_concurrency());
-  if (pixels.size() * std::size_t(m) * std::size_t(n) < 512) threads = 1;
-  {
-    std::vector<std::jthread> pool;
-    for (unsigned t = 1; t < std::min(threads, 2u); ++t) pool.emplace_back(worker);
-    worker();
-  }
-  double between = 0.0, within = 0.0;
-  for (std::size_t i = 0; i < pixels.size(); ++i) between += between_x[i], within += within_x[i];
-  return within > 0.0 ? between / within : 1.0;
+  // d at one camera sample: 0 where its ray meets no diffuse surface.
+  return sequence_noise_factor<Sampler>(rs, pixels, seed, scramblings, [&](auto& px, int x, int y) {
+    hit_record rec;
+    if (!sc.hit(camera_ray(cam, px, x, y, inv_w, inv_h), sc.ray_epsilon, infinity, rec)) return 0.0;
+    const auto* lam = std::get_if<lambertian>(&sc.materials[rec.material]);
+    if (!lam) return 0.0;
+    const vec3 nf = rec.facing_normal();
+    const vec2 u = px.get2d(dim);
+    light_sample lc, la;
+    const double fc = light_estimate(sc, s.sample_cheapest(rec.p, u, lc), lc, rec.p, nf);
+    const double fa = light_estimate(sc, s.sample(rec.p, nf, u, la), la, rec.p, nf);
+    return (double(lam->albedo.r) + lam->albedo.g + lam->albedo.b) / 3.0 * inv_pi * (fc - fa);
+  });
 }
 
 // With the image's sample generator (rs.sampler); 1 for independent samples.

@@ -553,34 +553,71 @@ inline void scale_emission_term(noise_pilot_result& r, double kappa_e) {
 // to s2_K(E), which stays unbiased over all pixels (a pixel whose K rays
 // all met the same radiance adds nothing to either). Hit tests only.
 // 1 for independent samples, and where no edge pixel was found.
+// What a sample generator leaves of the noise of a per-sample value at the
+// given pixels: sum_x w_x N Var_m(mean of the value over N samples) /
+// sum_x w_x Var(the value of one sample), with M independent scramblings of
+// N = rs.spp samples of type Sampler per pixel (seeded mix64(seed) + j),
+// Var(one) the sample variance of all M N values (each point of a scrambled
+// sequence is uniform, so it estimates one independent sample's variance;
+// the ratio is about 1 for independent samples). value(px, x, y) takes the
+// pixel sampler after start_sample and returns the sample's value (its
+// channels averaged by sample_variance). Per pixel its terms, summed in
+// pixel order afterwards (the result does not depend on the threads), on
+// up to two threads where the samples are 512 or more (starting a thread,
+// about 0.1 ms, costs more than it saves on fewer). 1 where nothing varies.
+template <class Sampler, class Value>
+double sequence_noise_factor(const render_settings& rs, std::span<const edge_pixel> pixels, std::uint64_t seed,
+                             int scramblings, Value&& value) {
+  const int m = std::max(scramblings, 2), n = std::max(rs.spp, 1);
+  std::vector<Sampler> samplers;
+  for (int j = 0; j < m; ++j) samplers.emplace_back(mix64(seed) + std::uint64_t(j), n);
+  std::vector<double> between_x(pixels.size(), 0.0), within_x(pixels.size(), 0.0);
+  std::atomic<std::size_t> next{0};
+  auto worker = [&] {
+    std::vector<glm::dvec3> means(static_cast<std::size_t>(m)), values(static_cast<std::size_t>(m) * n);
+    for (std::size_t xi; (xi = next.fetch_add(1, std::memory_order_relaxed)) < pixels.size();) {
+      const edge_pixel& x = pixels[xi];
+      for (int j = 0; j < m; ++j) {
+        auto px = samplers[static_cast<std::size_t>(j)].start_pixel(x.x, x.y, rs.width);
+        glm::dvec3 sum(0.0);
+        for (int k = 0; k < n; ++k) {
+          px.start_sample(k);
+          const glm::dvec3 v(value(px, x.x, x.y));
+          values[static_cast<std::size_t>(j) * n + k] = v;
+          sum += v;
+        }
+        means[static_cast<std::size_t>(j)] = sum / double(n);
+      }
+      between_x[xi] = x.weight * double(n) * sample_variance(means.data(), m);
+      within_x[xi] = x.weight * sample_variance(values.data(), m * n);
+    }
+  };
+  unsigned threads = rs.threads ? rs.threads : std::max(1u, std::thread::hardware_concurrency());
+  if (pixels.size() * std::size_t(m) * std::size_t(n) < 512) threads = 1;
+  {
+    std::vector<std::jthread> pool;
+    for (unsigned t = 1; t < std::min(threads, 2u); ++t) pool.emplace_back(worker);
+    worker();
+  }
+  double between = 0.0, within = 0.0;
+  for (std::size_t i = 0; i < pixels.size(); ++i) between += between_x[i], within += within_x[i];
+  return within > 0.0 ? between / within : 1.0;
+}
+
+// kappa_E (above) with samples of type Sampler: the value is E, what the
+// camera ray meets first (hit tests only).
 template <class Sampler, class Scene>
 double edge_noise_factor_with(const Scene& sc, const camera& cam, const render_settings& rs,
                               std::span<const edge_pixel> edges, int scramblings = 2, int pixels = 512) {
-  const int m = std::max(scramblings, 2), n = std::max(rs.spp, 1);
   const std::size_t count = std::min(edges.size(), static_cast<std::size_t>(std::max(pixels, 1)));
-  std::vector<Sampler> samplers;
-  // Their own seeds ("edgeq" and j): not the image's scramblings.
-  for (int j = 0; j < m; ++j) samplers.emplace_back(mix64(rs.seed ^ 0x6564676571ull) + std::uint64_t(j), n);
+  std::vector<edge_pixel> chosen;
+  for (std::size_t i = 0; i < count; ++i) chosen.push_back(edges[i * edges.size() / count]);
   const float inv_w = 1.0f / static_cast<float>(rs.width), inv_h = 1.0f / static_cast<float>(rs.height);
-  double between = 0.0, within = 0.0;
-  std::vector<glm::dvec3> means(static_cast<std::size_t>(m)), rays(static_cast<std::size_t>(m) * n);
-  for (std::size_t i = 0; i < count; ++i) {
-    const edge_pixel& e = edges[i * edges.size() / count];
-    for (int j = 0; j < m; ++j) {
-      auto px = samplers[static_cast<std::size_t>(j)].start_pixel(e.x, e.y, rs.width);
-      glm::dvec3 s(0.0);
-      for (int k = 0; k < n; ++k) {
-        px.start_sample(k);
-        const glm::dvec3 v(radiance_met_first(sc, camera_ray(cam, px, e.x, e.y, inv_w, inv_h)));
-        rays[static_cast<std::size_t>(j) * n + k] = v;
-        s += v;
-      }
-      means[static_cast<std::size_t>(j)] = s / double(n);
-    }
-    between += e.weight * double(n) * sample_variance(means.data(), m);
-    within += e.weight * sample_variance(rays.data(), m * n);
-  }
-  return within > 0.0 ? between / within : 1.0;
+  // Their own seeds ("edgeq" and j): not the image's scramblings.
+  return sequence_noise_factor<Sampler>(rs, chosen, rs.seed ^ 0x6564676571ull, scramblings,
+                                        [&](auto& px, int x, int y) {
+                                          return radiance_met_first(sc, camera_ray(cam, px, x, y, inv_w, inv_h));
+                                        });
 }
 
 // With the image's sample generator (rs.sampler); 1 for independent samples.
