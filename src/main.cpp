@@ -186,6 +186,10 @@ int run_render(const render_options& opt) {
       j["auto_image_variance_edges"] = noise->edge_variance;
       j["auto_edge_noise_factor"] = edge_factor;
       j["auto_albedo"] = std::sqrt(noise->mean_albedo2);
+      j["auto_pilot_ns_per_light_sample"] = noise->seconds_per_light_sample * 1e9;
+      j["auto_pilot_rays_per_light_sample"] = noise->rays_per_light_sample;
+      j["auto_pilot_paths_per_light_sample"] = noise->paths_per_light_sample;
+      j["auto_pilot_hits_per_light_sample"] = noise->hits_per_light_sample;
       nlohmann::ordered_json lights = nlohmann::ordered_json::array();
       for (const auto_light_settlement& a : settlements)
         lights.push_back({{"light", a.light},
@@ -259,7 +263,8 @@ int main(int argc, char** argv) {
                          "bilinear-solid-angle (comparison: bilinear cosine pre-warp)")
       ->check(CLI::IsMember({"area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle", "auto"}));
   render_cmd->add_option("--auto-rest-cost", ro.auto_rest_cost,
-                         "--light-sampling auto: the rest of the path's time per light sample, ns (default 265)");
+                         "--light-sampling auto: the rest of the path's time per light sample, ns (default: modelled from the "
+                         "pilot's rays per light sample; 265 with --auto-rest-variance)");
   render_cmd->add_option("--auto-rest-variance", ro.auto_rest_variance,
                          "--light-sampling auto: the relative variance the rest of the path adds, one value everywhere "
                          "(default: from the image's noise, measured by a pilot of up to 1024 pixels x 2 samples)");

@@ -111,6 +111,54 @@ TEST(ChoiceGainPilot, CountsALightSamplePerDiffuseBounce) {
   EXPECT_GT(count, 20u);
 }
 
+// The counting scene counts every ray an integrator traces and every hit:
+// a direct-light path to the lit floor traces its camera ray and one
+// shadow ray (both hit: the floor, the light); the same path's image is
+// the plain scene's.
+TEST(ChoiceGainPilot, CountsRaysAndHits) {
+  const scene sc = lit_floor();
+  std::uint64_t rays = 0, hits = 0;
+  const ray_counting_scene<scene> counting{sc, rays, hits};
+  const independent_sampler sampler(1, 1);
+  path_settings set;
+  set.max_depth = 1;
+  auto px = sampler.start_pixel(0, 0, 1);
+  px.start_sample(0);
+  const color counted = nee_integrator::li(counting, ray{{0.0f, 0.5f, 0.0f}, {0.0f, -1.0f, 0.0f}}, px, set);
+  EXPECT_EQ(rays, 2u);
+  EXPECT_EQ(hits, 2u);
+  auto px2 = sampler.start_pixel(0, 0, 1);
+  px2.start_sample(0);
+  EXPECT_EQ(counted, nee_integrator::li(sc, ray{{0.0f, 0.5f, 0.0f}, {0.0f, -1.0f, 0.0f}}, px2, set));
+  nee_integrator::li(counting, ray{{0.0f, 0.5f, 0.0f}, glm::normalize(vec3(5.0f, 1.0f, 0.0f))}, px, set);
+  EXPECT_EQ(rays, 3u);
+  EXPECT_EQ(hits, 2u) << "the ray up and past the light meets nothing";
+}
+
+// c_rest's model (render/rest_cost.hpp): each primitive type's tests per
+// ray add up over the scene's lists, and c_rest grows with the rays after
+// the camera's and with the tests.
+TEST(ChoiceGainPilot, RestCostModel) {
+  scene sc;
+  sc.materials = {lambertian{color(0.5f)}};
+  EXPECT_EQ(intersection_cost_per_ray(sc), 0.0f);
+  sc.add(xz_rect_shape{-1, 1, -1, 1, 0}, 0);
+  sc.add(xz_rect_shape{-1, 1, -1, 1, 2}, 0);
+  sc.add(sphere{vec3(0, 5, 0), 1.0f}, 0);
+  sc.add(ellipse::make({0, 3, 0}, {1, 0, 0}, {0, 0, 1}), 0);
+  EXPECT_FLOAT_EQ(intersection_cost_per_ray(sc),
+                  2 * rest_cost_model::axis_rect + rest_cost_model::sphere + rest_cost_model::ellipse);
+  const float tests = intersection_cost_per_ray(sc);
+  // Direct light, every path one light sample: a camera and a shadow ray.
+  EXPECT_FLOAT_EQ(modelled_rest_cost(2.0, 1.0, tests, 0.0f),
+                  rest_cost_model::ray + 2 * tests + rest_cost_model::sample);
+  EXPECT_GT(modelled_rest_cost(3.0, 1.0, tests, 0.0f), modelled_rest_cost(2.0, 1.0, tests, 0.0f));
+  EXPECT_GT(modelled_rest_cost(2.0, 1.0, 2 * tests, 0.0f), modelled_rest_cost(2.0, 1.0, tests, 0.0f));
+  EXPECT_FLOAT_EQ(modelled_rest_cost(2.0, 1.0, tests, rest_cost_model::ellipse_light) -
+                      modelled_rest_cost(2.0, 1.0, tests, 0.0f),
+                  rest_cost_model::ellipse_light);
+}
+
 // The pilot's light_variance (two light samples at each pixel's first point)
 // is an unbiased estimate of the mean over the image of the variance of one
 // light sample's direct light at the point a camera ray meets: 100 pilots
@@ -204,8 +252,8 @@ TEST(ChoiceGainPilot, KappaStratified) { check_choice_gain_factor<stratified_sam
 // light): with independent samples kappa is 1 and the rule sees V itself;
 // with Sobol samples kappa is in (0, 1) and V <= V_l = V (1 - (1 - kappa) s)
 // / kappa <= V / kappa, s in [0, 1] the larger of the measured and the
-// modelled share; c_rest is the pilot's time per light sample less the
-// cheapest strategy's modelled cost, or left as given.
+// modelled share; c_rest is modelled from the pilot's counts
+// (render/rest_cost.hpp), or left as given.
 TEST(ChoiceGainPilot, SettleWeighsEachAutoLight) {
   for (const sampler_kind kind : {sampler_kind::independent, sampler_kind::sobol}) {
     const rect r = xz_rect(-0.6f, 0.6f, -0.4f, 0.4f, 0.3f, true);
@@ -231,7 +279,8 @@ TEST(ChoiceGainPilot, SettleWeighsEachAutoLight) {
     const std::vector<auto_light_settlement> a = settle_auto_lights(sc, cam, rs, noise, 64);
     ASSERT_EQ(a.size(), 1u);
     EXPECT_EQ(a[0].light, 0u);
-    EXPECT_NEAR(a[0].rest_cost, noise.seconds_per_light_sample * 1e9 - auto_costs::rect.area, 1e-3);
+    EXPECT_EQ(a[0].rest_cost, modelled_rest_cost(noise.rays_per_light_sample, noise.paths_per_light_sample,
+                                                 intersection_cost_per_ray(sc), 0.0f));
     EXPECT_NEAR(a[0].noise_share_measured, noise.light_variance[0] / noise.image_variance,
                 1e-5 * a[0].noise_share_measured);
     EXPECT_GE(a[0].noise_share, 0.0);

@@ -409,6 +409,33 @@ TEST_F(Cli, AutoTakesTheCheapestStrategyWhereItsChoiceDoesNotPay) {
   }
 }
 
+// `auto`'s choices follow from the scene, the seed and the pilot's counts,
+// never from how long a run took (render/rest_cost.hpp): the same command
+// gives the same image and the same settlement of its light (c_rest, kappa,
+// V_l) for any thread count and on every run, here where kappa is measured
+// (a large lamp low over the floor, Sobol samples).
+TEST_F(Cli, AutoIsReproducible) {
+  const std::string floor = R"({"type": "xz_rect", "x0": -5, "x1": 5, "z0": -5, "z1": 5, "k": 0, "material": "white"})";
+  const std::string lamp = R"({"type": "xz_rect", "x0": -1.5, "x1": 1.5, "z0": -1.5, "z1": 1.5, "k": 0.3, "material": "light", "flip": true})";
+  const fs::path s = write("lamp.json", scene_with(floor + ", " + lamp + R"(, {"type": "sphere", "center": [0.3, 0.1, -0.2], "radius": 0.1, "material": "white"})"));
+  std::vector<nlohmann::json> lights;
+  for (const char* threads : {"1", "2", "2"}) {
+    const fs::path out = dir / (std::string("o") + std::to_string(lights.size()) + ".exr"), stats = dir / "s.json";
+    ASSERT_EQ(run("render " + s.string() + " -o " + out.string() + " --width 64 --height 48 --spp 8 --seed 2 --max-depth 1 "
+                  "--integrator nee --light-sampling auto --quiet --threads " + threads + " --stats " + stats.string()).status, 0);
+    const auto j = nlohmann::json::parse(slurp(stats));
+    ASSERT_EQ(j["auto_lights"].size(), 1u);
+    lights.push_back(j["auto_lights"][0]);
+    EXPECT_LT(lights.back()["gain_factor"].get<double>(), 1.0) << "kappa measured";
+    if (lights.size() > 1) {
+      EXPECT_EQ(lights.back(), lights.front()) << threads;
+      const result r = run("diff " + out.string() + " " + (dir / "o0.exr").string() + " --json");
+      ASSERT_EQ(r.status, 0) << r.err;
+      EXPECT_EQ(nlohmann::json::parse(r.out)["mse"].get<double>(), 0.0) << threads;
+    }
+  }
+}
+
 // mcrt samples: the CSV of the contract, to a file or to stdout; samples on
 // the light with their pdf, rows of pdf 0 where the light faces away; bad
 // arguments refused with one line and exit 2, the output untouched.

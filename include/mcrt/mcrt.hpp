@@ -26,6 +26,7 @@
 #include "mcrt/render/mis_integrator.hpp"
 #include "mcrt/render/noise_pilot.hpp"
 #include "mcrt/render/choice_gain_pilot.hpp"
+#include "mcrt/render/rest_cost.hpp"
 #include "mcrt/render/mixture_integrator.hpp"
 #include "mcrt/render/nee_integrator.hpp"
 #include "mcrt/render/path.hpp"

@@ -71,6 +71,7 @@
 #include "mcrt/render/light.hpp"
 #include "mcrt/render/noise_pilot.hpp"
 #include "mcrt/render/renderer.hpp"
+#include "mcrt/render/rest_cost.hpp"
 #include "mcrt/samplers/independent.hpp"
 #include "mcrt/samplers/layout.hpp"
 #include "mcrt/samplers/samplers.hpp"
@@ -105,7 +106,7 @@ double choice_gain_factor_with(const Scene& sc, const camera& cam, const render_
     const double fc = light_estimate(sc, s.sample_cheapest(rec.p, u, lc), lc, rec.p, nf);
     const double fa = light_estimate(sc, s.sample(rec.p, nf, u, la), la, rec.p, nf);
     return (double(lam->albedo.r) + lam->albedo.g + lam->albedo.b) / 3.0 * inv_pi * (fc - fa);
-  });
+  }, 1024);  // two light samples and shadow rays each: about 250 ns
 }
 
 // With the image's sample generator (rs.sampler); 1 for independent samples.
@@ -140,7 +141,7 @@ struct auto_light_settlement {
 template <class Scene>
 std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& cam, const render_settings& rs,
                                                       const noise_pilot_result& noise, int pixels,
-                                                      bool measure_rest_cost = true) {
+                                                      bool model_rest_cost = true) {
   std::vector<auto_light_settlement> out;
   for (std::size_t i = 0; i < sc.lights.size(); ++i) {
     std::optional<light> rebuilt;
@@ -150,10 +151,11 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
         [&]<class S>(const S& s) {
           if constexpr (strategy_of<S>() == light_sampling::automatic) {
             auto_params p = s.params;
-            // The time per light sample the pilot's paths took, less the
-            // cheapest strategy's modelled part of it, is c_rest.
-            if (measure_rest_cost && noise.seconds_per_light_sample > 0.0)
-              p.rest_cost = std::max(0.0f, float(noise.seconds_per_light_sample * 1e9) - s.cheapest_cost());
+            // c_rest from the pilot's counted rays and paths per light
+            // sample (render/rest_cost.hpp).
+            if (model_rest_cost && noise.rays_per_light_sample > 0.0)
+              p.rest_cost = modelled_rest_cost(noise.rays_per_light_sample, noise.paths_per_light_sample,
+                                               intersection_cost_per_ray(sc), light_shape_cost<decltype(s.shape)>());
             a.rest_cost = p.rest_cost;
             const S with_cost(s.shape, p);
             a.image_variance = p.image_variance;

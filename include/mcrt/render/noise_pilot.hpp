@@ -66,11 +66,12 @@
 // (f1 - f2)^2 / 2 (with albedo / pi, over the light's choice probability),
 // an unbiased estimate of the variance one light sample adds there; its
 // mean over the blocks, as V's, is light_variance, the light's part of V
-// with its sampler (render/choice_gain_pilot.hpp). And the paths' time:
-// each row's paths are timed apart from the rest of the pilot, their light
-// samples counted (counting_pixel_sampler); seconds_per_light_sample, the
-// time per light sample with the cheapest strategies and independent
-// samples, gives `auto` its c_rest.
+// with its sampler (render/choice_gain_pilot.hpp). And the paths' work:
+// their light samples counted (counting_pixel_sampler), and their rays
+// (ray_counting_scene), per light sample, give `auto` its c_rest
+// (render/rest_cost.hpp); each row's paths are also timed apart from the
+// rest of the pilot (seconds_per_light_sample: reported, not used, as a
+// check of that model on the machine at hand).
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -94,6 +95,28 @@ struct noise_pilot_settings {
   int spp = 2;             // samples per pixel (>= 2: a sample variance needs two)
   int emission_rays = 8;   // K: camera rays per measured pixel, spread over the finer blocks, for the
                            // variance of what they meet first (header; < 2: none)
+};
+
+// A scene that counts the rays traced in it (its hit tests) and otherwise is
+// the scene it wraps: what an integrator reads of a scene, by reference.
+template <class Scene>
+struct ray_counting_scene {
+  const Scene& inner;
+  std::uint64_t& rays;
+  std::uint64_t& hits;
+  const decltype(Scene::lights)& lights = inner.lights;
+  const decltype(Scene::emitters)& emitters = inner.emitters;
+  const decltype(Scene::materials)& materials = inner.materials;
+  const color& background = inner.background;
+  const float& ray_epsilon = inner.ray_epsilon;
+  const std::size_t& unsampled_emitters = inner.unsampled_emitters;
+
+  bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
+    ++rays;
+    const bool h = inner.hit(r, tmin, tmax, rec);
+    hits += h;
+    return h;
+  }
 };
 
 // The pilot `mcrt render` runs for an image of width x height at spp: 1024
@@ -233,11 +256,15 @@ struct noise_pilot_result {
   std::vector<double> light_variance;
   // The pilot's paths' time (one thread's) per light sample they took: a
   // light sample's share of a path's time with the cheapest strategies and
-  // independent samples (0 where they took none).
+  // independent samples (0 where they took none). Measured, so it varies
+  // from run to run: reported only (render/rest_cost.hpp models it).
   double seconds_per_light_sample = 0.0;
   // The share of those light samples taken at the paths' first bounce (1
   // with direct light alone).
   double first_bounce_share = 1.0;
+  // The rays those paths traced (hit tests: camera, continuation and
+  // shadow rays) and the paths themselves, per light sample (counted).
+  double rays_per_light_sample = 0.0, hits_per_light_sample = 0.0, paths_per_light_sample = 0.0;
   std::vector<edge_pixel> edge_pixels;   // the pixels with s2_K(E) > 0 (footprint, finer blocks), weights in pixels
 };
 
@@ -347,7 +374,8 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
   using pilot_pixel_sampler = decltype(sampler.start_pixel(0, 0, 1));
   std::vector<double> row_path_seconds(static_cast<std::size_t>(ny), 0.0);
   std::vector<std::uint64_t> row_light_samples(static_cast<std::size_t>(ny), 0),
-      row_first_light_samples(static_cast<std::size_t>(ny), 0);
+      row_first_light_samples(static_cast<std::size_t>(ny), 0), row_rays(static_cast<std::size_t>(ny), 0),
+      row_hits(static_cast<std::size_t>(ny), 0);
   auto worker = [&] {
     std::vector<block_pixel> blocks;
     std::vector<pilot_pixel_sampler> pixel_samplers;
@@ -402,7 +430,8 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
         blocks.push_back(pick(i, j, k, nx, 0));
         pixel_samplers.push_back(sampler.start_pixel(blocks.back().x, blocks.back().y, rs.width));
       }
-      std::uint64_t light_samples = 0, first_light_samples = 0;
+      std::uint64_t light_samples = 0, first_light_samples = 0, rays = 0, hits = 0;
+      const ray_counting_scene<Scene> counting{sc, rays, hits};
       const auto paths_start = std::chrono::steady_clock::now();
       for (int i = 0; i < nx; ++i) {
         auto& px = pixel_samplers[static_cast<std::size_t>(i)];
@@ -412,13 +441,14 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
           const ray r = camera_ray(cam, px, blocks[static_cast<std::size_t>(i)].x, blocks[static_cast<std::size_t>(i)].y,
                                    inv_w, inv_h);
           path_rays[static_cast<std::size_t>(i * m + s)] = r;
-          path_values[static_cast<std::size_t>(i * m + s)] = Integrator::li(sc, r, counted, set);
+          path_values[static_cast<std::size_t>(i * m + s)] = Integrator::li(counting, r, counted, set);
         }
       }
       row_path_seconds[static_cast<std::size_t>(j)] =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - paths_start).count();
       row_light_samples[static_cast<std::size_t>(j)] = light_samples;
       row_first_light_samples[static_cast<std::size_t>(j)] = first_light_samples;
+      row_rays[static_cast<std::size_t>(j)] = rays, row_hits[static_cast<std::size_t>(j)] = hits;
       for (int i = 0; i < nx; ++i) {
         const block_pixel b = blocks[static_cast<std::size_t>(i)];
         const int x = b.x, y = b.y;
@@ -509,13 +539,17 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
   out.light_variance.resize(nl, 0.0);
   for (double& v : out.light_variance) v = weights > 0.0 ? v / weights : 0.0;
   double path_seconds = 0.0;
-  std::uint64_t light_samples = 0, first_light_samples = 0;
+  std::uint64_t light_samples = 0, first_light_samples = 0, rays = 0, hits = 0;
   for (std::size_t j = 0; j < static_cast<std::size_t>(ny); ++j)
     path_seconds += row_path_seconds[j], light_samples += row_light_samples[j],
-        first_light_samples += row_first_light_samples[j];
+        first_light_samples += row_first_light_samples[j], rays += row_rays[j],
+        hits += row_hits[j];
   if (light_samples > 0) {
     out.seconds_per_light_sample = path_seconds / double(light_samples);
     out.first_bounce_share = double(first_light_samples) / double(light_samples);
+    out.rays_per_light_sample = double(rays) / double(light_samples);
+    out.hits_per_light_sample = double(hits) / double(light_samples);
+    out.paths_per_light_sample = double(nx) * ny * m / double(light_samples);
   }
   if (diffuse > 0) out.mean_albedo2 = albedo2 / diffuse;
   return out;
@@ -563,11 +597,14 @@ inline void scale_emission_term(noise_pilot_result& r, double kappa_e) {
 // pixel sampler after start_sample and returns the sample's value (its
 // channels averaged by sample_variance). Per pixel its terms, summed in
 // pixel order afterwards (the result does not depend on the threads), on
-// up to two threads where the samples are 512 or more (starting a thread,
-// about 0.1 ms, costs more than it saves on fewer). 1 where nothing varies.
+// up to two threads where the samples are parallel_from or more: starting
+// a thread costs about 0.1 ms here, more than it saves on less than about
+// 0.3 ms of work (the choice gain pilot's 528 samples of a 100 x 100 image
+// at 8 spp: 0.15 ms on one thread, 0.26 ms on two; its 2112 at 32 spp:
+// 0.5-0.7 ms and 0.35 ms). 1 where nothing varies.
 template <class Sampler, class Value>
 double sequence_noise_factor(const render_settings& rs, std::span<const edge_pixel> pixels, std::uint64_t seed,
-                             int scramblings, Value&& value) {
+                             int scramblings, Value&& value, std::size_t parallel_from) {
   const int m = std::max(scramblings, 2), n = std::max(rs.spp, 1);
   std::vector<Sampler> samplers;
   for (int j = 0; j < m; ++j) samplers.emplace_back(mix64(seed) + std::uint64_t(j), n);
@@ -593,7 +630,7 @@ double sequence_noise_factor(const render_settings& rs, std::span<const edge_pix
     }
   };
   unsigned threads = rs.threads ? rs.threads : std::max(1u, std::thread::hardware_concurrency());
-  if (pixels.size() * std::size_t(m) * std::size_t(n) < 512) threads = 1;
+  if (pixels.size() * std::size_t(m) * std::size_t(n) < parallel_from) threads = 1;
   {
     std::vector<std::jthread> pool;
     for (unsigned t = 1; t < std::min(threads, 2u); ++t) pool.emplace_back(worker);
@@ -617,7 +654,8 @@ double edge_noise_factor_with(const Scene& sc, const camera& cam, const render_s
   return sequence_noise_factor<Sampler>(rs, chosen, rs.seed ^ 0x6564676571ull, scramblings,
                                         [&](auto& px, int x, int y) {
                                           return radiance_met_first(sc, camera_ray(cam, px, x, y, inv_w, inv_h));
-                                        });
+                                        },
+                                        4096);  // a hit test each: about 60 ns
 }
 
 // With the image's sample generator (rs.sampler); 1 for independent samples.
