@@ -78,6 +78,9 @@ int run_render(const render_options& opt) {
 
   const cli::ellipse_map map = opt.ellipse_map == "polar" ? cli::ellipse_map::polar : cli::ellipse_map::parallel;
   auto_params ap;
+  // nee takes each light sample's pdf with it: `auto` weighs the strategies'
+  // costs inside such renders (auto_costs).
+  ap.pdf_with_sample = opt.integrator == "nee";
   if (opt.auto_rest_cost) {
     if (!(*opt.auto_rest_cost >= 0.0f) || !std::isfinite(*opt.auto_rest_cost))
       throw input_error("--auto-rest-cost: must be a finite number >= 0");

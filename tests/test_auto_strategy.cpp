@@ -221,6 +221,55 @@ TEST(AutoStrategy, PlainChoices) {
   EXPECT_EQ(choose_strategy(small, far_o, -up), light_sampling::area);
 }
 
+// With nee (auto_params::pdf_with_sample) the rule weighs the strategies'
+// costs inside renders (auto_costs::*_nee), the cheapest the same and the
+// dearer ones less: every receiver that takes a dearer strategy with the
+// sample + pdf costs takes one with nee's, and some take one only with
+// nee's (a grid of receivers and normals under a rectangle, a disk and a
+// sphere, v_rest fixed).
+TEST(AutoStrategy, NeeCostsAreTheRendersAndOnlyWidenTheDearerChoices) {
+  auto_params sp, nee;
+  nee.pdf_with_sample = true;
+  EXPECT_EQ(&auto_costs::rect_for(nee), &auto_costs::rect_nee);
+  EXPECT_EQ(&auto_costs::rect_for(sp), &auto_costs::rect);
+  EXPECT_EQ(&auto_costs::sphere_for(false, nee), &auto_costs::sphere_crossing_nee);
+  const std::pair<auto_costs::shape_costs, auto_costs::shape_costs> tables[] = {
+      {auto_costs::rect, auto_costs::rect_nee}, {auto_costs::ellipse, auto_costs::ellipse_nee},
+      {auto_costs::sphere_above, auto_costs::sphere_above_nee},
+      {auto_costs::sphere_crossing, auto_costs::sphere_crossing_nee}};
+  for (const auto& [with_pdf, in_render] : tables) {
+    const float cheapest = std::min({with_pdf.area, with_pdf.solid_angle, with_pdf.projected_solid_angle});
+    EXPECT_EQ(std::min({in_render.area, in_render.solid_angle, in_render.projected_solid_angle}), cheapest);
+    EXPECT_EQ(auto_choice::cheapest(in_render), auto_choice::cheapest(with_pdf));
+    EXPECT_LE(in_render.area, with_pdf.area);
+    EXPECT_LE(in_render.solid_angle, with_pdf.solid_angle);
+    EXPECT_LE(in_render.projected_solid_angle, with_pdf.projected_solid_angle);
+  }
+  const rect r = xz_rect(-0.5f, 0.5f, -0.4f, 0.4f, 0.0f, true);
+  const ellipse e = ellipse::make({0, 0, 0}, {0.5f, 0, 0}, {0, 0, 0.4f});
+  const sphere s{vec3(0.0f, 0.3f, 0.0f), 0.25f};
+  int only_nee[3] = {0, 0, 0};
+  for (int i = 0; i < 12; ++i)
+    for (int j = 0; j < 8; ++j)
+      for (int k = 0; k < 4; ++k) {
+        const vec3 o(-1.2f + 0.2f * float(i), -0.05f - 0.25f * float(j), 0.1f);
+        const float a = 0.45f * float(k);
+        const vec3 n = glm::normalize(vec3(std::sin(a), std::cos(a), 0.0f));
+        const light_sampling choices[3][2] = {
+            {choose_strategy(r, o, n, sp), choose_strategy(r, o, n, nee)},
+            {choose_strategy(e, o, n, sp), choose_strategy(e, o, n, nee)},
+            {choose_strategy(s, o, n, sp), choose_strategy(s, o, n, nee)}};
+        const light_sampling cheapest[3] = {light_sampling::area, light_sampling::area, light_sampling::solid_angle};
+        for (int l = 0; l < 3; ++l) {
+          if (choices[l][0] != cheapest[l]) {
+            EXPECT_NE(choices[l][1], cheapest[l]) << l << " " << i << " " << j << " " << k;
+          }
+          only_nee[l] += choices[l][0] == cheapest[l] && choices[l][1] != cheapest[l];
+        }
+      }
+  for (int l = 0; l < 3; ++l) EXPECT_GT(only_nee[l], 0) << l;
+}
+
 // Whether the choice pays for its own cost (auto_sampler::table_gain): at
 // receivers far from a light every choice is the cheapest strategy, so the
 // mean gain is exactly minus the lookup's cost in the score's units

@@ -29,7 +29,9 @@
 // v_area and v_sa (their samples there are wasted), not v_psa.
 //
 // The constants (struct auto_costs) are measurements: the strategies'
-// costs from the README's cost tables, c_rest from the error-against-time
+// costs from the README's cost tables (sample + pdf) or, for nee, which
+// takes a light sample's pdf with it, inside renders
+// (bench/strategy_costs.py), c_rest from the error-against-time
 // study (cornell_rect, nee, sobol: ms per spp of area and solid-angle
 // sampling, 318 and 451 ns per path at 1.13 light samples per path, leave
 // 265 ns per light sample for the rest); a fixed v_rest = 4 is the value,
@@ -103,6 +105,10 @@ struct auto_params {
   float image_variance = 0.0f;   // V: mean variance of a pixel sample (radiance^2); 0: use rest_variance
   float radiance = 1.0f;         // L: the light's radiance (mean of its channels)
   float albedo = 1.0f;           // rho: the receivers' albedo (root mean square)
+  // The integrator takes each light sample's pdf with the sample and
+  // evaluates no light pdf apart (nee): the strategies' costs inside such
+  // renders (auto_costs::*_nee); otherwise (the mixture, mis) sample + pdf.
+  bool pdf_with_sample = false;
 
   // v_rest at a point where the light's projected solid angle is omega_proj
   // (infinite where the light gives nothing: no strategy helps there; also
@@ -128,6 +134,26 @@ struct auto_costs {
   // horizon (a numerical inversion) than above it (closed form).
   static constexpr shape_costs sphere_above{74.0f, 54.0f, 100.0f};
   static constexpr shape_costs sphere_crossing{74.0f, 54.0f, 600.0f};
+  // With nee, a light sample's time inside a render: the cheapest
+  // strategy's cost as above, the others' by what they add to a render's
+  // time per light sample (bench/strategy_costs.py: nee, Sobol, one thread,
+  // the size and distance families' scenes, direct and global light,
+  // medians: rectangle +77 / +354 ns (direct), +79 / +365 (global) for solid
+  // angle / projected solid angle; ellipse +344 / +728, +347 / +745; sphere:
+  // area +21 / +16, projected cap +16 / +19 over the cone). They are 0.4-0.7
+  // of the sample + pdf benchmarks' differences: no pdf, and the sampler's
+  // work overlaps the path's. The sphere's crossing case, rare in those
+  // scenes, is the benchmark's difference scaled as the cap above it's.
+  static constexpr shape_costs rect_nee{17.0f, 95.0f, 377.0f};
+  static constexpr shape_costs ellipse_nee{31.0f, 376.0f, 766.0f};
+  static constexpr shape_costs sphere_above_nee{74.0f, 54.0f, 72.0f};
+  static constexpr shape_costs sphere_crossing_nee{74.0f, 54.0f, 268.0f};
+  static const shape_costs& rect_for(const auto_params& p) { return p.pdf_with_sample ? rect_nee : rect; }
+  static const shape_costs& ellipse_for(const auto_params& p) { return p.pdf_with_sample ? ellipse_nee : ellipse; }
+  static const shape_costs& sphere_for(bool above, const auto_params& p) {
+    if (p.pdf_with_sample) return above ? sphere_above_nee : sphere_crossing_nee;
+    return above ? sphere_above : sphere_crossing;
+  }
   // What a light sample pays for the choice itself (the table's lookup and
   // the dispatch to the chosen sampler), beyond the chosen strategy's cost:
   // `auto` held to area sampling everywhere against area sampling, 1
@@ -554,10 +580,10 @@ inline bool delta_v_area(const ellipse& e, const vec3& o, const vec3& n, float& 
   return planar_rule(e).delta_v_area(o, n, v);
 }
 inline light_sampling choose_strategy(const rect& r, const vec3& o, const vec3& n, const auto_params& p = {}) {
-  return planar_rule(r).choose(o, n, p);
+  return planar_rule(r, auto_costs::rect_for(p)).choose(o, n, p);
 }
 inline light_sampling choose_strategy(const ellipse& e, const vec3& o, const vec3& n, const auto_params& p = {}) {
-  return planar_rule(e).choose(o, n, p);
+  return planar_rule(e, auto_costs::ellipse_for(p)).choose(o, n, p);
 }
 // Spheres: a cap above the horizon whose cosine varies little is the
 // cone's without the quadrature. To first order in the cap's size v_sa =
@@ -573,7 +599,7 @@ inline light_sampling choose_strategy(const sphere& s, const vec3& o, const vec3
   const vec3 v = s.center - o;
   const float h = glm::dot(v, n), r2 = s.radius * s.radius, d2 = glm::dot(v, v);
   const bool above = sphere_above_horizon(s, o, n);
-  const auto_costs::shape_costs& c = above ? auto_costs::sphere_above : auto_costs::sphere_crossing;
+  const auto_costs::shape_costs& c = auto_costs::sphere_for(above, p);
   if (above) {
     const float v_sa = r2 * (d2 - h * h) / (4.0f * d2 * h * h);  // tan^2(theta_c) sin^2(alpha) / 4
     // Omega_proj = pi sin^2(alpha) cos(theta_c) for a cap above the horizon.
@@ -591,9 +617,10 @@ inline light_sampling choose_strategy(const sphere& s, const vec3& o, const vec3
 class tabulated_planar_rule {
  public:
   tabulated_planar_rule(const rect& r, const auto_params& p)
-      : tabulated_planar_rule(planar_rule(r), r.corner + 0.5f * (r.e1 + r.e2), 0.5f * r.e1, 0.5f * r.e2, r.n, p) {}
+      : tabulated_planar_rule(planar_rule(r, auto_costs::rect_for(p)), r.corner + 0.5f * (r.e1 + r.e2), 0.5f * r.e1,
+                              0.5f * r.e2, r.n, p) {}
   tabulated_planar_rule(const ellipse& e, const auto_params& p)
-      : tabulated_planar_rule(planar_rule(e), e.center, e.a1, e.a2, e.n, p) {}
+      : tabulated_planar_rule(planar_rule(e, auto_costs::ellipse_for(p)), e.center, e.a1, e.a2, e.n, p) {}
 
   light_sampling choose(const vec3& o, const vec3& n) const { return table_.lookup(o, n); }
 
@@ -640,19 +667,18 @@ class tabulated_sphere_rule {
   // As tabulated_planar_rule::gain, over the cheapest strategy (the cone).
   float gain(const vec3& o, const vec3& n) const {
     const auto_choice m = auto_model(sphere_, o, n);
-    const auto_costs::shape_costs& c =
-        sphere_above_horizon(sphere_, o, n) ? auto_costs::sphere_above : auto_costs::sphere_crossing;
+    const auto_costs::shape_costs& c = auto_costs::sphere_for(sphere_above_horizon(sphere_, o, n), params_);
     return m.score_of(cheapest(), 0.0f, c, params_) - m.score_of(choose(o, n), auto_costs::table_lookup, c, params_);
   }
   // The same above the horizon and across it.
-  light_sampling cheapest() const { return auto_choice::cheapest(auto_costs::sphere_above); }
+  light_sampling cheapest() const { return auto_choice::cheapest(auto_costs::sphere_for(true, params_)); }
   // As tabulated_planar_rule::noise_share, with the cone (v_sa).
   float noise_share(const vec3& o, const vec3& n) const {
     const auto_choice m = auto_model(sphere_, o, n);
     return m.v_solid_angle() / m.rest_variance(params_);
   }
   float cheapest_cost() const {
-    const auto_costs::shape_costs& c = auto_costs::sphere_above;
+    const auto_costs::shape_costs& c = auto_costs::sphere_for(true, params_);
     return std::min({c.area, c.solid_angle, c.projected_solid_angle});
   }
 
