@@ -34,7 +34,9 @@
 #include <tuple>
 #include <type_traits>
 
+#include "mcrt/geometry/box.hpp"
 #include "mcrt/geometry/ellipse.hpp"
+#include "mcrt/geometry/rect.hpp"
 #include "mcrt/geometry/sphere.hpp"
 #include "mcrt/render/scene.hpp"
 
@@ -55,7 +57,10 @@ constexpr float intersection_test_cost() {
   if constexpr (std::is_same_v<Shape, rect>) return rest_cost_model::rect;
   else if constexpr (std::is_same_v<Shape, ellipse>) return rest_cost_model::ellipse;
   else if constexpr (std::is_same_v<Shape, sphere>) return rest_cost_model::sphere;
-  else return rest_cost_model::box;
+  else {
+    static_assert(std::is_same_v<Shape, box>, "a primitive type without a measured test cost");
+    return rest_cost_model::box;
+  }
 }
 
 // sum_t n_t c_t: the modelled time of one ray's intersection tests, ns.
