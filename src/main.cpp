@@ -192,7 +192,6 @@ int run_render(const render_options& opt) {
       j["auto_pilot_ns_per_light_sample"] = noise->seconds_per_light_sample * 1e9;
       j["auto_pilot_rays_per_light_sample"] = noise->rays_per_light_sample;
       j["auto_pilot_paths_per_light_sample"] = noise->paths_per_light_sample;
-      j["auto_pilot_hits_per_light_sample"] = noise->hits_per_light_sample;
       nlohmann::ordered_json lights = nlohmann::ordered_json::array();
       for (const auto_light_settlement& a : settlements)
         lights.push_back({{"light", a.light},

@@ -169,9 +169,7 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
             for (std::size_t k = 0; k < noise.receivers.size(); ++k)
               if (with_cost.choice(noise.receivers[k].p, noise.receivers[k].n) != s.cheapest())
                 dearer.push_back(noise.receiver_pixels[k]);
-            const std::size_t count = std::min(dearer.size(), static_cast<std::size_t>(std::max(pixels, 1)));
-            std::vector<edge_pixel> chosen;
-            for (std::size_t k = 0; k < count; ++k) chosen.push_back(dearer[k * dearer.size() / count]);
+            const std::vector<edge_pixel> chosen = evenly_spaced(dearer, pixels);
             // Measured on the first bounce's light samples; at deeper
             // bounces the sequence leaves about all of the light's noise
             // (header), so over a path's light samples kappa is the

@@ -103,7 +103,6 @@ template <class Scene>
 struct ray_counting_scene {
   const Scene& inner;
   std::uint64_t& rays;
-  std::uint64_t& hits;
   const decltype(Scene::lights)& lights = inner.lights;
   const decltype(Scene::emitters)& emitters = inner.emitters;
   const decltype(Scene::materials)& materials = inner.materials;
@@ -113,9 +112,7 @@ struct ray_counting_scene {
 
   bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
     ++rays;
-    const bool h = inner.hit(r, tmin, tmax, rec);
-    hits += h;
-    return h;
+    return inner.hit(r, tmin, tmax, rec);
   }
 };
 
@@ -264,7 +261,7 @@ struct noise_pilot_result {
   double first_bounce_share = 1.0;
   // The rays those paths traced (hit tests: camera, continuation and
   // shadow rays) and the paths themselves, per light sample (counted).
-  double rays_per_light_sample = 0.0, hits_per_light_sample = 0.0, paths_per_light_sample = 0.0;
+  double rays_per_light_sample = 0.0, paths_per_light_sample = 0.0;
   std::vector<edge_pixel> edge_pixels;   // the pixels with s2_K(E) > 0 (footprint, finer blocks), weights in pixels
 };
 
@@ -374,8 +371,7 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
   using pilot_pixel_sampler = decltype(sampler.start_pixel(0, 0, 1));
   std::vector<double> row_path_seconds(static_cast<std::size_t>(ny), 0.0);
   std::vector<std::uint64_t> row_light_samples(static_cast<std::size_t>(ny), 0),
-      row_first_light_samples(static_cast<std::size_t>(ny), 0), row_rays(static_cast<std::size_t>(ny), 0),
-      row_hits(static_cast<std::size_t>(ny), 0);
+      row_first_light_samples(static_cast<std::size_t>(ny), 0), row_rays(static_cast<std::size_t>(ny), 0);
   auto worker = [&] {
     std::vector<block_pixel> blocks;
     std::vector<pilot_pixel_sampler> pixel_samplers;
@@ -430,8 +426,8 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
         blocks.push_back(pick(i, j, k, nx, 0));
         pixel_samplers.push_back(sampler.start_pixel(blocks.back().x, blocks.back().y, rs.width));
       }
-      std::uint64_t light_samples = 0, first_light_samples = 0, rays = 0, hits = 0;
-      const ray_counting_scene<Scene> counting{sc, rays, hits};
+      std::uint64_t light_samples = 0, first_light_samples = 0, rays = 0;
+      const ray_counting_scene<Scene> counting{sc, rays};
       const auto paths_start = std::chrono::steady_clock::now();
       for (int i = 0; i < nx; ++i) {
         auto& px = pixel_samplers[static_cast<std::size_t>(i)];
@@ -448,7 +444,7 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
           std::chrono::duration<double>(std::chrono::steady_clock::now() - paths_start).count();
       row_light_samples[static_cast<std::size_t>(j)] = light_samples;
       row_first_light_samples[static_cast<std::size_t>(j)] = first_light_samples;
-      row_rays[static_cast<std::size_t>(j)] = rays, row_hits[static_cast<std::size_t>(j)] = hits;
+      row_rays[static_cast<std::size_t>(j)] = rays;
       for (int i = 0; i < nx; ++i) {
         const block_pixel b = blocks[static_cast<std::size_t>(i)];
         const int x = b.x, y = b.y;
@@ -539,16 +535,14 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
   out.light_variance.resize(nl, 0.0);
   for (double& v : out.light_variance) v = weights > 0.0 ? v / weights : 0.0;
   double path_seconds = 0.0;
-  std::uint64_t light_samples = 0, first_light_samples = 0, rays = 0, hits = 0;
+  std::uint64_t light_samples = 0, first_light_samples = 0, rays = 0;
   for (std::size_t j = 0; j < static_cast<std::size_t>(ny); ++j)
     path_seconds += row_path_seconds[j], light_samples += row_light_samples[j],
-        first_light_samples += row_first_light_samples[j], rays += row_rays[j],
-        hits += row_hits[j];
+        first_light_samples += row_first_light_samples[j], rays += row_rays[j];
   if (light_samples > 0) {
     out.seconds_per_light_sample = path_seconds / double(light_samples);
     out.first_bounce_share = double(first_light_samples) / double(light_samples);
     out.rays_per_light_sample = double(rays) / double(light_samples);
-    out.hits_per_light_sample = double(hits) / double(light_samples);
     out.paths_per_light_sample = double(nx) * ny * m / double(light_samples);
   }
   if (diffuse > 0) out.mean_albedo2 = albedo2 / diffuse;
@@ -641,14 +635,20 @@ double sequence_noise_factor(const render_settings& rs, std::span<const edge_pix
   return within > 0.0 ? between / within : 1.0;
 }
 
+// At most `count` (>= 1) of the pixels, evenly spaced in their list.
+inline std::vector<edge_pixel> evenly_spaced(std::span<const edge_pixel> pixels, int count) {
+  const std::size_t n = std::min(pixels.size(), static_cast<std::size_t>(std::max(count, 1)));
+  std::vector<edge_pixel> chosen;
+  for (std::size_t i = 0; i < n; ++i) chosen.push_back(pixels[i * pixels.size() / n]);
+  return chosen;
+}
+
 // kappa_E (above) with samples of type Sampler: the value is E, what the
 // camera ray meets first (hit tests only).
 template <class Sampler, class Scene>
 double edge_noise_factor_with(const Scene& sc, const camera& cam, const render_settings& rs,
                               std::span<const edge_pixel> edges, int scramblings = 2, int pixels = 512) {
-  const std::size_t count = std::min(edges.size(), static_cast<std::size_t>(std::max(pixels, 1)));
-  std::vector<edge_pixel> chosen;
-  for (std::size_t i = 0; i < count; ++i) chosen.push_back(edges[i * edges.size() / count]);
+  const std::vector<edge_pixel> chosen = evenly_spaced(edges, pixels);
   const float inv_w = 1.0f / static_cast<float>(rs.width), inv_h = 1.0f / static_cast<float>(rs.height);
   // Their own seeds ("edgeq" and j): not the image's scramblings.
   return sequence_noise_factor<Sampler>(rs, chosen, rs.seed ^ 0x6564676571ull, scramblings,
