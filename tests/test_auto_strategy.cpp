@@ -318,6 +318,44 @@ TEST(AutoStrategy, TableGainWeighsTheChoiceAgainstItsCost) {
   EXPECT_FALSE(use_cheapest_where_choice_does_not_pay(cone, far));
 }
 
+// The rule's models at the receivers (auto_sampler::receiver_models) are
+// the light's and the points' alone: made by a sampler with other params
+// (another image variance and rest cost), they give table_gain,
+// noise_share and the swap the very values those evaluate themselves.
+TEST(AutoStrategy, ReceiverModelsServeEveryParams) {
+  auto_params p, q;
+  p.image_variance = 1e-3f, p.radiance = 10.0f;
+  q.image_variance = 1e6f, q.radiance = 10.0f, q.rest_cost = 40.0f;
+  std::vector<auto_receiver> rs;
+  for (int i = 0; i < 40; ++i) {
+    const float x = -0.6f + 0.03f * float(i);
+    rs.push_back({vec3(x, -0.05f - 0.02f * float(i), 0.1f * x), glm::normalize(vec3(0.1f * x, 1, 0.05f))});
+    rs.push_back({vec3(0.55f, -0.02f - 0.05f * float(i), x), vec3(-1, 0, 0)});
+  }
+  auto check = [&](const auto& a, const auto& b) {
+    const std::vector<auto_choice> models = b.receiver_models(rs);
+    ASSERT_EQ(models.size(), rs.size());
+    EXPECT_EQ(a.table_gain(rs, models), a.table_gain(rs));
+    EXPECT_EQ(a.noise_share(std::span<const auto_choice>(models)), a.noise_share(rs));
+    light with(a), without(a);
+    EXPECT_EQ(use_cheapest_where_choice_does_not_pay(with, rs, models),
+              use_cheapest_where_choice_does_not_pay(without, rs));
+  };
+  const rect lamp = xz_rect(-0.5f, 0.5f, -0.4f, 0.4f, 0.0f, true);
+  const ellipse disk = ellipse::make({0, 0, 0}, {0.5f, 0, 0}, {0, 0, 0.4f});
+  const sphere ball{vec3(0.0f, 0.5f, 0.0f), 0.3f};
+  for (const auto_params& a : {p, q})
+    for (const auto_params& b : {p, q}) {
+      check(rect_auto_sampler(lamp, a), rect_auto_sampler(lamp, b));
+      check(ellipse_auto_sampler(disk, a), ellipse_auto_sampler(disk, b));
+      check(sphere_auto_sampler(ball, a), sphere_auto_sampler(ball, b));
+    }
+  // Both gates are exercised: the choice pays at these receivers in the
+  // quiet image and not in the noisy one.
+  EXPECT_GT(rect_auto_sampler(lamp, p).table_gain(rs), 0.0f);
+  EXPECT_LE(rect_auto_sampler(lamp, q).table_gain(rs), 0.0f);
+}
+
 // The auto strategy is the chosen strategy, bit for bit: the same sample
 // and pdf for the same u, the same pdf() for any direction; and its
 // sample's pdf agrees with pdf() as the strategies' own tests require (1e-4

@@ -145,6 +145,9 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
   std::vector<auto_light_settlement> out;
   for (std::size_t i = 0; i < sc.lights.size(); ++i) {
     std::optional<light> rebuilt;
+    // The rule's models at the pilot's receivers: the light's and the
+    // points' alone, so one evaluation serves every params weighed below.
+    std::vector<auto_choice> models;
     auto_light_settlement a;
     a.light = i;
     std::visit(
@@ -161,7 +164,8 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
             a.image_variance = p.image_variance;
             // kappa <= 1 only weighs the choice's gain down (V_l >= V): where
             // the choice does not pay with V, it is not measured.
-            if (!(with_cost.table_gain(noise.receivers) > 0.0f)) {
+            models = with_cost.receiver_models(noise.receivers);
+            if (!(with_cost.table_gain(noise.receivers, models) > 0.0f)) {
               rebuilt = with_cost;
               return;
             }
@@ -180,7 +184,7 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
             const double v = s.params.image_variance;
             const double measured = i < noise.light_variance.size() && v > 0.0 ? noise.light_variance[i] / v : 0.0;
             a.noise_share_measured = measured;
-            a.noise_share_model = s.noise_share(noise.receivers);
+            a.noise_share_model = s.noise_share(models);
             a.noise_share = std::clamp(std::max(measured, a.noise_share_model), 0.0, 1.0);
             a.image_variance = a.kappa > 0.0 ? v * (1.0 - (1.0 - a.kappa) * a.noise_share) / a.kappa
                                              : double(std::numeric_limits<float>::max());
@@ -191,7 +195,7 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
         sc.lights[i]);
     if (!rebuilt) continue;
     sc.lights[i] = std::move(*rebuilt);
-    a.cheapest = use_cheapest_where_choice_does_not_pay(sc.lights[i], noise.receivers);
+    a.cheapest = use_cheapest_where_choice_does_not_pay(sc.lights[i], noise.receivers, models);
     out.push_back(a);
   }
   return out;

@@ -62,13 +62,16 @@ inline light_sampling strategy_of(const light& l) {
 // A light sampled by `auto` whose choice per shading point does not pay for
 // its own cost at the receivers rs (auto_sampler::table_gain) becomes its
 // cheapest strategy's sampler, with no choice per light sample. Returns
-// whether it did; other lights are left as they are.
-inline bool use_cheapest_where_choice_does_not_pay(light& l, std::span<const auto_receiver> rs) {
+// whether it did; other lights are left as they are. models: the light's
+// rule's models at rs (auto_sampler::receiver_models), where the caller
+// has them; empty, they are evaluated here.
+inline bool use_cheapest_where_choice_does_not_pay(light& l, std::span<const auto_receiver> rs,
+                                                   std::span<const auto_choice> models = {}) {
   std::optional<light> cheapest;
   std::visit(
       [&]<class S>(const S& s) {
         if constexpr (strategy_of<S>() == light_sampling::automatic)
-          if (!(s.table_gain(rs) > 0.0f)) {
+          if (!((models.empty() ? s.table_gain(rs) : s.table_gain(rs, models)) > 0.0f)) {
             if (s.cheapest() == light_sampling::area)
               cheapest = s.area;
             else

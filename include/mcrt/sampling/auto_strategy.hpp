@@ -57,6 +57,7 @@
 #include <limits>
 #include <span>
 #include <variant>
+#include <vector>
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
@@ -624,23 +625,22 @@ class tabulated_planar_rule {
 
   light_sampling choose(const vec3& o, const vec3& n) const { return table_.lookup(o, n); }
 
-  // The modelled gain (auto_choice::score, the fine rule at o) of the
-  // table's choice at (o, n), its lookup's cost included, over the
+  // The fine rule's model at (o, n): what gain and noise_share weigh. It
+  // depends on the light and the point alone, not on the params.
+  auto_choice model(const vec3& o, const vec3& n) const { return rule_.fine(o, n); }
+  // The modelled gain (auto_choice::score, the fine rule's model m at o) of
+  // the table's choice at (o, n), its lookup's cost included, over the
   // cheapest strategy (area sampling).
-  float gain(const vec3& o, const vec3& n) const {
-    const auto_choice m = rule_.fine(o, n);
+  float gain(const auto_choice& m, const vec3& o, const vec3& n) const {
     const auto_costs::shape_costs& c = rule_.costs();
     return m.score_of(auto_choice::cheapest(c), 0.0f, c, params_) -
            m.score_of(choose(o, n), auto_costs::table_lookup, c, params_);
   }
   light_sampling cheapest() const { return auto_choice::cheapest(rule_.costs()); }
-  // The light's own noise at (o, n) with its cheapest strategy (area
-  // sampling), relative to the image's: v_area / v_rest = D^2 v_area / V,
-  // its share of V at the point (the fine rule's; 0 where it gives nothing).
-  float noise_share(const vec3& o, const vec3& n) const {
-    const auto_choice m = rule_.fine(o, n);
-    return m.v_area() / m.rest_variance(params_);
-  }
+  // The light's own noise at the model's point with its cheapest strategy
+  // (area sampling), relative to the image's: v_area / v_rest = D^2 v_area
+  // / V, its share of V at the point (0 where it gives nothing).
+  float noise_share(const auto_choice& m) const { return m.v_area() / m.rest_variance(params_); }
   float cheapest_cost() const {
     const auto_costs::shape_costs& c = rule_.costs();
     return std::min({c.area, c.solid_angle, c.projected_solid_angle});
@@ -664,19 +664,17 @@ class tabulated_sphere_rule {
         table_(s.center, s.radius, [s, p](const vec3& o, const vec3& n) { return choose_strategy(s, o, n, p); }) {}
   light_sampling choose(const vec3& o, const vec3& n) const { return table_.lookup(o, n); }
 
+  // As tabulated_planar_rule's: the visible cap's model (auto_model).
+  auto_choice model(const vec3& o, const vec3& n) const { return auto_model(sphere_, o, n); }
   // As tabulated_planar_rule::gain, over the cheapest strategy (the cone).
-  float gain(const vec3& o, const vec3& n) const {
-    const auto_choice m = auto_model(sphere_, o, n);
+  float gain(const auto_choice& m, const vec3& o, const vec3& n) const {
     const auto_costs::shape_costs& c = auto_costs::sphere_for(sphere_above_horizon(sphere_, o, n), params_);
     return m.score_of(cheapest(), 0.0f, c, params_) - m.score_of(choose(o, n), auto_costs::table_lookup, c, params_);
   }
   // The same above the horizon and across it.
   light_sampling cheapest() const { return auto_choice::cheapest(auto_costs::sphere_for(true, params_)); }
   // As tabulated_planar_rule::noise_share, with the cone (v_sa).
-  float noise_share(const vec3& o, const vec3& n) const {
-    const auto_choice m = auto_model(sphere_, o, n);
-    return m.v_solid_angle() / m.rest_variance(params_);
-  }
+  float noise_share(const auto_choice& m) const { return m.v_solid_angle() / m.rest_variance(params_); }
   float cheapest_cost() const {
     const auto_costs::shape_costs& c = auto_costs::sphere_for(true, params_);
     return std::min({c.area, c.solid_angle, c.projected_solid_angle});
@@ -729,9 +727,24 @@ struct auto_sampler {
   // the scores' first form); infinite otherwise (the table is kept).
   float table_gain(std::span<const auto_receiver> rs) const {
     if (!(params.image_variance > 0.0f)) return std::numeric_limits<float>::infinity();
+    return table_gain(rs, receiver_models(rs));
+  }
+  // The same with the rule's models at the receivers given (receiver_models,
+  // of this light with any params: a caller that weighs several params at
+  // the same receivers evaluates the models once).
+  float table_gain(std::span<const auto_receiver> rs, std::span<const auto_choice> models) const {
+    if (!(params.image_variance > 0.0f)) return std::numeric_limits<float>::infinity();
     double sum = 0.0;
-    for (const auto_receiver& r : rs) sum += rule_.gain(r.p, r.n);
+    for (std::size_t i = 0; i < rs.size(); ++i) sum += rule_.gain(models[i], rs[i].p, rs[i].n);
     return rs.empty() ? 0.0f : static_cast<float>(sum / double(rs.size()));
+  }
+  // The rule's model at each receiver (the fine rule's for planar lights,
+  // the visible cap's for spheres): the light's and the points' alone.
+  std::vector<auto_choice> receiver_models(std::span<const auto_receiver> rs) const {
+    std::vector<auto_choice> models;
+    models.reserve(rs.size());
+    for (const auto_receiver& r : rs) models.push_back(rule_.model(r.p, r.n));
+    return models;
   }
   // The shape's cheapest strategy (area for planar lights, the cone for
   // spheres), whose sampler is the member area or solid_angle.
@@ -742,11 +755,13 @@ struct auto_sampler {
   // strategy, as modelled (independent samples): the mean over the
   // receivers rs of D^2 v_cheapest / V (the rules' noise_share). Defined
   // where v_rest comes from the image's noise; 0 otherwise.
-  float noise_share(std::span<const auto_receiver> rs) const {
-    if (!(params.image_variance > 0.0f) || rs.empty()) return 0.0f;
+  float noise_share(std::span<const auto_receiver> rs) const { return noise_share(receiver_models(rs)); }
+  // The same from the rule's models at the receivers (receiver_models).
+  float noise_share(std::span<const auto_choice> models) const {
+    if (!(params.image_variance > 0.0f) || models.empty()) return 0.0f;
     double sum = 0.0;
-    for (const auto_receiver& r : rs) sum += rule_.noise_share(r.p, r.n);
-    return static_cast<float>(sum / double(rs.size()));
+    for (const auto_choice& m : models) sum += rule_.noise_share(m);
+    return static_cast<float>(sum / double(models.size()));
   }
   // Its sample (the choice's, where the choice is the cheapest strategy).
   bool sample_cheapest(const vec3& o, vec2 u, light_sample& s) const {
