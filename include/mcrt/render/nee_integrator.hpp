@@ -54,9 +54,7 @@ color sample_direct_light(const Scene& sc, const vec3& p, const vec3& n, const c
   if (!(cos_theta > 0.0f)) return color(0.0f);
   const float p_light = sel.pdf(s.dir, k, s.pdf);
   if (!(p_light > 0.0f) || !std::isfinite(p_light)) return color(0.0f);
-  hit_record srec;
-  if (!sc.hit(ray{p, s.dir}, sc.ray_epsilon, infinity, srec)) return color(0.0f);
-  const color le = emitted(sc.materials[srec.material], srec);
+  const color le = shadow_ray_radiance(sc, p, s.dir);
   if (le == color(0.0f)) return color(0.0f);
   const float w = Weights::light(set, p_light, cos_theta * inv_pi);
   return le * albedo * (cos_theta * inv_pi * w / p_light);

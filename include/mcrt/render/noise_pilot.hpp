@@ -162,15 +162,14 @@ color radiance_met_first(const Scene& sc, const ray& r) {
 // shadow ray meets first (the channels' mean), times cos(theta) / pdf; 0
 // where the light offered no sample (ok false, pdf 0), below the surface, or
 // where the shadow ray meets no emitter's front side. As the integrators'
-// sample_direct_light (render/nee_integrator.hpp) with one light.
+// sample_direct_light (render/nee_integrator.hpp) with one light, always
+// chosen.
 template <class Scene>
 double light_estimate(const Scene& sc, bool ok, const light_sample& ls, const vec3& p, const vec3& nf) {
   if (!ok || !(ls.pdf > 0.0f) || !std::isfinite(ls.pdf)) return 0.0;
   const float c = glm::dot(ls.dir, nf);
   if (!(c > 0.0f)) return 0.0;
-  hit_record srec;
-  if (!sc.hit(ray{p, ls.dir}, sc.ray_epsilon, infinity, srec)) return 0.0;
-  const color le = emitted(sc.materials[srec.material], srec);
+  const color le = shadow_ray_radiance(sc, p, ls.dir);
   return (double(le.r) + le.g + le.b) / 3.0 * c / double(ls.pdf);
 }
 

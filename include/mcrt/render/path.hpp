@@ -1,8 +1,8 @@
 #pragma once
 // What the integrators (mixture_integrator.hpp, nee_integrator.hpp,
-// mis_integrator.hpp) share: the settings of a path, Russian roulette, and
-// the specular materials' scattering fed from a sampler on the dimensions of
-// samplers/layout.hpp.
+// mis_integrator.hpp) share: the settings of a path, a shadow ray's
+// radiance, Russian roulette, and the specular materials' scattering fed
+// from a sampler on the dimensions of samplers/layout.hpp.
 #include <algorithm>
 
 #include "mcrt/core/dispatch.hpp"
@@ -28,6 +28,17 @@ struct path_settings {
   // mis: the heuristic of the weights (mis.hpp).
   mis_heuristic heuristic = mis_heuristic::power;
 };
+
+// The radiance a shadow ray from p along dir brings back: that of the
+// front side of the emitter it meets first; 0 where it meets nothing (the
+// background is not a light a light sample can choose) or a surface that
+// does not emit.
+template <class Scene>
+color shadow_ray_radiance(const Scene& sc, const vec3& p, const vec3& dir) {
+  hit_record rec;
+  if (!sc.hit(ray{p, dir}, sc.ray_epsilon, infinity, rec)) return color(0.0f);
+  return emitted(sc.materials[rec.material], rec);
+}
 
 // Russian roulette on the throughput (as pbrt-v4): a path whose throughput
 // is below 1 survives with that probability, and its throughput is divided
