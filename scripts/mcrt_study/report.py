@@ -304,8 +304,10 @@ def build_tables(rows: list[dict], settings: Settings, scenes: list[SceneInfo],
     return text, summary, analysis
 
 
-def machine_info() -> dict[str, str]:
-    """CPU model, core count, OS, and the repository's git commit."""
+def machine_info(out: Path | None = None) -> dict[str, str]:
+    """CPU model, core count, OS, and the repository's git commit; changes
+    under `out` (the study's own outputs, rewritten by the run) do not count
+    as uncommitted changes."""
     cpu = platform.processor() or platform.machine()
     try:
         for line in Path("/proc/cpuinfo").read_text(encoding="utf-8").splitlines():
@@ -318,7 +320,14 @@ def machine_info() -> dict[str, str]:
     try:
         head = subprocess.run(["git", "-C", str(REPO_ROOT), "rev-parse", "HEAD"],
                               capture_output=True, text=True, check=True).stdout.strip()
-        dirty = subprocess.run(["git", "-C", str(REPO_ROOT), "status", "--porcelain", "--untracked-files=no"],
+        exclude = []
+        if out is not None:
+            try:
+                exclude = [":(exclude)" + str(Path(out).resolve().relative_to(REPO_ROOT.resolve()))]
+            except ValueError:  # outside the repository
+                pass
+        dirty = subprocess.run(["git", "-C", str(REPO_ROOT), "status", "--porcelain", "--untracked-files=no",
+                                "--", "."] + exclude,
                                capture_output=True, text=True, check=True).stdout.strip()
         commit = head + (" (with uncommitted changes)" if dirty else "")
     except (OSError, subprocess.CalledProcessError):
@@ -360,7 +369,7 @@ def write_report(settings: Settings, scenes: list[SceneInfo], tables: str,
     """Write tables.md and the report README.md (relative links to the plots)."""
     out = settings.out
     write_text_atomic(out / TABLES_MD, tables)
-    info = machine_info()
+    info = machine_info(out)
     state = read_state(out / STATE_JSON)
     mcrt_hash = sha256_file(settings.mcrt)[:12] if settings.mcrt.is_file() else "?"
     threads = str(settings.threads) if settings.threads else f"all ({info['cores']})"
