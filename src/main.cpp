@@ -122,13 +122,18 @@ int run_render(const render_options& opt) {
   std::optional<noise_pilot_result> noise;
   double edge_factor = 1.0;  // kappa_E (render/noise_pilot.hpp)
   std::vector<auto_light_settlement> settlements;
+  // The pilot's parts (auto_pilot_seconds is their sum): the noise pilot,
+  // kappa_E, and the lights' settling.
+  double noise_seconds = 0.0, emission_seconds = 0.0, settle_seconds = 0.0;
   if (pilot && ls.auto_lights > 0) {
     noise = estimate_image_variance(ls.world, cam, rs, noise_pilot_for(rs.width, rs.height, rs.spp));
+    noise_seconds = noise->seconds;
     // The emission term with the image's own samples (render/noise_pilot.hpp).
     const auto start = std::chrono::steady_clock::now();
     edge_factor = edge_noise_factor(ls.world, cam, rs, noise->edge_pixels);
     scale_emission_term(*noise, edge_factor);
-    noise->seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    emission_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    noise->seconds += emission_seconds;
     // A noise-free pilot leaves nothing for a cheaper strategy to hide in.
     ap.image_variance = std::max(static_cast<float>(noise->image_variance), std::numeric_limits<float>::min());
     ap.albedo = static_cast<float>(std::sqrt(noise->mean_albedo2));
@@ -140,7 +145,8 @@ int run_render(const render_options& opt) {
                                      !opt.auto_rest_cost);
     for (const auto_light_settlement& a : settlements)
       if (a.cheapest) ls.auto_cheapest_lights.push_back(static_cast<std::uint32_t>(a.light));
-    noise->seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - settle_start).count();
+    settle_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - settle_start).count();
+    noise->seconds += settle_seconds;
   }
 
   render_result res = render_scene(ls.world, cam, rs, opt.quiet ? progress_callback{} : progress_callback(print_progress));
@@ -185,6 +191,7 @@ int run_render(const render_options& opt) {
     if (noise) {
       j["auto_cheapest_lights"] = ls.auto_cheapest_lights.size();
       j["auto_pilot_seconds"] = noise->seconds;
+      j["auto_pilot_parts_seconds"] = {{"noise", noise_seconds}, {"emission", emission_seconds}, {"settle", settle_seconds}};
       j["auto_image_variance"] = noise->image_variance;
       j["auto_image_variance_edges"] = noise->edge_variance;
       j["auto_edge_noise_factor"] = edge_factor;
@@ -202,7 +209,8 @@ int run_render(const render_options& opt) {
                           {"noise_share_model", a.noise_share_model},
                           {"image_variance", a.image_variance},
                           {"rest_cost", a.rest_cost},
-                          {"cheapest", a.cheapest}});
+                          {"cheapest", a.cheapest},
+                          {"gain_factor_seconds", a.kappa_seconds}});
       j["auto_lights"] = lights;
     }
     write_text(opt.stats, j.dump(2) + "\n");

@@ -346,6 +346,20 @@ TEST_F(Cli, AutoNoisePilotInStats) {
   EXPECT_GT(j["auto_setup_seconds"].get<double>(), 0.0);
   EXPECT_LE(j["auto_pilot_seconds"].get<double>() + j["auto_setup_seconds"].get<double>(),
             j["render_seconds"].get<double>());
+  // The pilot's parts add up to its time, each one's measured (> 0), and
+  // each light's kappa measurement lies within the settling.
+  ASSERT_TRUE(j.contains("auto_pilot_parts_seconds"));
+  double parts = 0.0;
+  for (const char* part : {"noise", "emission", "settle"}) {
+    ASSERT_TRUE(j["auto_pilot_parts_seconds"].contains(part)) << part;
+    EXPECT_GT(j["auto_pilot_parts_seconds"][part].get<double>(), 0.0) << part;
+    parts += j["auto_pilot_parts_seconds"][part].get<double>();
+  }
+  EXPECT_NEAR(parts, j["auto_pilot_seconds"].get<double>(), 1e-12 * parts);
+  ASSERT_EQ(j["auto_lights"].size(), 1u);
+  EXPECT_GE(j["auto_lights"][0]["gain_factor_seconds"].get<double>(), 0.0);
+  EXPECT_LE(j["auto_lights"][0]["gain_factor_seconds"].get<double>(),
+            j["auto_pilot_parts_seconds"]["settle"].get<double>());
   // The emission term with the image's samples (no emitter in view here:
   // no edge pixels, kappa_E = 1), and with independent samples kappa_E = 1.
   for (const char* sampler : {"sobol", "independent"}) {
@@ -426,6 +440,8 @@ TEST_F(Cli, AutoIsReproducible) {
     const auto j = nlohmann::json::parse(slurp(stats));
     ASSERT_EQ(j["auto_lights"].size(), 1u);
     lights.push_back(j["auto_lights"][0]);
+    EXPECT_GT(lights.back()["gain_factor_seconds"].get<double>(), 0.0) << "kappa measured";
+    lights.back().erase("gain_factor_seconds");  // a time: the one part that may differ
     EXPECT_LT(lights.back()["gain_factor"].get<double>(), 1.0) << "kappa measured";
     if (lights.size() > 1) {
       EXPECT_EQ(lights.back(), lights.front()) << threads;

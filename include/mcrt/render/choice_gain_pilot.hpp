@@ -62,6 +62,7 @@
 // strip light of the mixed scene (cornell_two_lights, global light) got
 // V_l = 6 V and area sampling, 0.36x the best fixed strategy.
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <span>
 #include <variant>
@@ -125,6 +126,7 @@ struct auto_light_settlement {
   std::size_t light = 0;        // index in the scene's lights
   double kappa = 1.0;           // what the image's samples leave of the choice's gain (header)
   double kappa_first_bounce = 1.0;  // of which at the first bounce's light samples
+  double kappa_seconds = 0.0;   // the time its measurement took (0 where it was not measured)
   double noise_share = 0.0;     // s: the light's own noise with its cheapest strategy, over V
   double noise_share_measured = 0.0, noise_share_model = 0.0;
   double image_variance = 0.0;  // V_l: the V its rule sees
@@ -178,7 +180,9 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
             // bounces the sequence leaves about all of the light's noise
             // (header), so over a path's light samples kappa is the
             // first bounce's share of them times kappa plus the rest.
+            const auto kappa_start = std::chrono::steady_clock::now();
             a.kappa_first_bounce = choice_gain_factor(sc, cam, rs, with_cost, chosen);
+            a.kappa_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - kappa_start).count();
             const double f = std::clamp(noise.first_bounce_share, 0.0, 1.0);
             a.kappa = f * a.kappa_first_bounce + (1.0 - f);
             const double v = s.params.image_variance;
