@@ -124,7 +124,7 @@ struct ray_counting_scene {
 // first point, its centre's ray and its emission rays: 0.73 us of one
 // thread against 0.11 us per image sample, size_rect_x4, direct light), so
 // that the pilot takes 1-2 % of the image's time on one thread. (With 1 %
-// of the image's samples, until commit fff8980, it took 6 % of a 100 x 100
+// of the image's samples, before commit a4ddd74, it took 6 % of a 100 x 100
 // image at 8 spp, and `auto` 0.94x the best fixed strategy where that was
 // area sampling everywhere, against 0.98x with 0.25 %: A/B, direct light,
 // 8 and 32 spp x 4 seeds.)

@@ -755,7 +755,10 @@ struct auto_sampler {
   // strategy, as modelled (independent samples): the mean over the
   // receivers rs of D^2 v_cheapest / V (the rules' noise_share). Defined
   // where v_rest comes from the image's noise; 0 otherwise.
-  float noise_share(std::span<const auto_receiver> rs) const { return noise_share(receiver_models(rs)); }
+  float noise_share(std::span<const auto_receiver> rs) const {
+    if (!(params.image_variance > 0.0f) || rs.empty()) return 0.0f;  // before the models' work
+    return noise_share(receiver_models(rs));
+  }
   // The same from the rule's models at the receivers (receiver_models).
   float noise_share(std::span<const auto_choice> models) const {
     if (!(params.image_variance > 0.0f) || models.empty()) return 0.0f;
