@@ -300,3 +300,42 @@ TEST(ChoiceGainPilot, SettleWeighsEachAutoLight) {
     EXPECT_EQ(settle_auto_lights(fixed, cam, rs, noise, 64, false)[0].rest_cost, p.rest_cost);
   }
 }
+
+// The light's noise share s is at most V's reflected part, 1 - V_E / V
+// (V_E the pilot's emission term, edge_variance: what the camera rays meet
+// first holds none of a light sample's noise): the same pilot with its
+// emission term set to 0, 0.3 and 0.9 of V gives s = min(max(measured,
+// modelled), 1 - V_E / V), and at 0.9 the cap is what sets it.
+TEST(ChoiceGainPilot, NoiseShareAtMostTheReflectedPart) {
+  const rect r = xz_rect(-0.6f, 0.6f, -0.4f, 0.4f, 0.3f, true);
+  render_settings rs = settings(64, 64);
+  rs.spp = 8;
+  rs.sampler = sampler_kind::sobol;
+  rs.seed = 9;
+  const camera cam({0, 1.0f, -1.5f}, {0, 0, 0}, {0, 1, 0}, 60, 1.0f);
+  scene pilot_scene;
+  pilot_scene.materials = {lambertian{color(0.5f)}, diffuse_light{color(4.0f)}};
+  pilot_scene.add(xz_rect_shape{-50, 50, -50, 50, 0}, 0);
+  pilot_scene.add_light(rect_area_sampler{r}, 1);
+  pilot_scene.ray_epsilon = 1e-4f;
+  const noise_pilot_result pilot = estimate_image_variance(pilot_scene, cam, rs);
+  ASSERT_GT(pilot.image_variance, 0.0);
+  bool capped = false;
+  for (const double f : {0.0, 0.3, 0.9}) {
+    noise_pilot_result noise = pilot;
+    noise.edge_variance = f * noise.image_variance;
+    auto_params p;
+    p.image_variance = static_cast<float>(noise.image_variance);
+    p.radiance = 4.0f;
+    p.albedo = 0.5f;
+    scene sc = pilot_scene;
+    sc.lights[0] = rect_auto_sampler(r, p);
+    const std::vector<auto_light_settlement> a = settle_auto_lights(sc, cam, rs, noise, 64);
+    ASSERT_EQ(a.size(), 1u);
+    ASSERT_LT(a[0].kappa, 1.0) << "the premise: kappa measured (the choice pays with V)";
+    const double larger = std::max(a[0].noise_share_measured, a[0].noise_share_model);
+    EXPECT_NEAR(a[0].noise_share, std::clamp(larger, 0.0, 1.0 - f), 1e-6) << f;  // V in float in the rule's params
+    if (f == 0.9) capped = larger > 0.1;
+  }
+  EXPECT_TRUE(capped) << "the cap sets s at V_E = 0.9 V";
+}

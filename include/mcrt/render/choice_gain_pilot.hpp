@@ -38,12 +38,21 @@
 //
 // The light's own noise with its cheapest strategy is a share s of V: the
 // pilot's light_variance over V, or the rule's model of it at the pilot's
-// receivers (auto_sampler::noise_share), the larger, at most 1 (each alone
+// receivers (auto_sampler::noise_share), the larger (each alone
 // varied 0.1-1.7 and 0.5-7 between seeds over a floor at 0.3 light sizes,
 // area sampling's noise near a light being heavy-tailed; taking the larger
-// errs towards the choice). The image's samples leave kappa of
+// errs towards the choice), at most the share of V's reflected part,
+// 1 - V_E / V: V_E, V's emission term (what camera rays meet first, at
+// its size with the image's samples: noise_pilot_result::edge_variance),
+// holds none of a light sample's noise. The image's samples leave kappa of
 // it: the image's noise is V (1 - (1 - kappa) s), and the choice gains
-// kappa of what the rule models. The rule of the light then sees
+// kappa of what the rule models. Near s = 1 V_l is steep in s (dV_l / ds =
+// -V (1 - kappa) / kappa, -6 V at kappa = 0.14), and at s = 1 kappa
+// cancels (V_l = V): capped at 1 instead, s took V_l to V on a box under a
+// disk light covering most of its ceiling with direct light
+// (size_disk_x8, 8 and 32 spp), where V_E is 9-22 % of V and the choice
+// then lost to area sampling everywhere (0.83x); with the cap V_l is
+// 1.8-3 V there. The rule of the light then sees
 // V_l = V (1 - (1 - kappa) s) / kappa (auto_params::image_variance): its
 // scores v_s / v_rest = kappa D^2 v_s / (V (1 - (1 - kappa) s)) are the
 // modelled gains with the image's samples against the image's noise with
@@ -189,7 +198,9 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
             const double measured = i < noise.light_variance.size() && v > 0.0 ? noise.light_variance[i] / v : 0.0;
             a.noise_share_measured = measured;
             a.noise_share_model = s.noise_share(models);
-            a.noise_share = std::clamp(std::max(measured, a.noise_share_model), 0.0, 1.0);
+            // At most V's reflected part (header).
+            const double reflected = v > 0.0 ? std::clamp(1.0 - noise.edge_variance / v, 0.0, 1.0) : 1.0;
+            a.noise_share = std::clamp(std::max(measured, a.noise_share_model), 0.0, reflected);
             a.image_variance = a.kappa > 0.0 ? v * (1.0 - (1.0 - a.kappa) * a.noise_share) / a.kappa
                                              : double(std::numeric_limits<float>::max());
             p.image_variance = static_cast<float>(std::min(a.image_variance, double(std::numeric_limits<float>::max())));

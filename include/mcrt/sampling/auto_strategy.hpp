@@ -56,6 +56,7 @@
 #include <algorithm>
 #include <limits>
 #include <span>
+#include <tuple>
 #include <variant>
 #include <vector>
 #if defined(__SSE2__)
@@ -210,6 +211,9 @@ class auto_choice {
   void set_exact_omega_proj(float omega_proj, float area_scale) {
     omega_proj_ = omega_proj, mean_g_ = omega_proj / area_scale;
   }
+  // v_area where g peaks between the rule's points, integrated about the
+  // peak (planar_rule::peak_v_area): v_area() takes it there.
+  void set_peak_v_area(float v) { v_peak_ = v; }
   float omega_proj() const { return omega_proj_; }
   float rest_variance(const auto_params& p) const { return p.rest_variance_at(omega_proj_); }
 
@@ -217,13 +221,23 @@ class auto_choice {
   // v_area: the quadrature's, unless g at the light's nearest point exceeds
   // twice the quadrature's mean and the rule's points do not resolve the
   // peak (planar_rule::model sets g_peak only then): then the receiver is
-  // close to the light, g ~ delta^2 / r^4 peaks at the nearest point, and a
-  // fixed rule misses the peak; there the variance of that
-  // peak, (q - 1) / 3 with q = g_peak / E[g] (for g = delta^2 / r^4 over a
-  // large light E_A[g^2] / E_A[g]^2 = A / (3 pi delta^2) = q / 3), bounds it
-  // from below. At q = 2 both forms give 1/3 (g linear from 0 to 2 E[g]).
+  // close to the light, g peaks at the nearest point, and a fixed rule
+  // misses the peak. There the fine rule integrates v_area about the peak
+  // (planar_rule::peak_v_area, set_peak_v_area; within 4 % of the exact
+  // value). Without it (the coarse rule) the peak's variance for a
+  // receiver facing the light, (q - 1) / 3 with q = g_peak / E[g] (for g =
+  // delta^2 / r^4 over a large light E_A[g^2] / E_A[g]^2 = A / (3 pi
+  // delta^2) = q / 3), stands in; at q = 2 both forms give 1/3 (g linear
+  // from 0 to 2 E[g]). That is the largest of the peak's shapes: over a
+  // large light E_A[g^2] / E_A[g]^2 is 4 sqrt(3) q / 27 for a receiver whose
+  // normal lies in the light's plane, and beside the light (farther from
+  // its edge than from its plane) 5 q / 24 facing it, 5 q / 32 with the
+  // normal in the plane; on the walls under a large ceiling light the
+  // bound was 1.6-1.8 times the true v_area (tests/test_auto_strategy.cpp,
+  // PeakVarianceIntegrated).
   float v_area() const {
     if (!(sg_ > 0.0f)) return 0.0f;
+    if (peaked() && v_peak_ >= 0.0f) return v_peak_;
     const float v = std::max(sg2_ / (sg_ * sg_) - 1.0f, 0.0f);
     const float mean = mean_g_ > 0.0f ? mean_g_ : sg_;
     return peaked() ? std::max(v, (g_peak_ / mean - 1.0f) * (1.0f / 3.0f)) : v;
@@ -306,6 +320,7 @@ class auto_choice {
   vec3 o_, n_;
   float sg_ = 0.0f, sg2_ = 0.0f, sw_ = 0.0f, swc_ = 0.0f, swc2_ = 0.0f, g_peak_ = 0.0f;
   float omega_proj_ = 0.0f, mean_g_ = 0.0f;
+  float v_peak_ = -1.0f;  // v_area integrated about g's peak (< 0: not done)
 };
 
 // The rule of a planar light (rectangle or ellipse), with what depends on
@@ -399,6 +414,115 @@ class planar_rule {
 
   const auto_costs::shape_costs& costs() const { return costs_; }
   auto_choice coarse(const vec3& o, const vec3& n) const { return model(coarse_, o, n); }
+
+  // Area sampling's relative variance E_A[g^2] / E_A[g]^2 - 1 at a receiver
+  // whose g peaks between the rule's points, integrated about o's foot F on
+  // the light's plane (height h > 0) instead of over the light's surface:
+  // in polar coordinates (rho, phi) about F with rho = h tan(u), u the
+  // angle from the plane's normal at o,
+  //   g dA   = cos+(theta) sin(u) du dphi              (Lambert: cos dw),
+  //   g^2 dA = cos+(theta)^2 cos^3(u) sin(u) du dphi / h^2,
+  // cos(theta) = a cos(u) + b sin(u), a = n . (-n_l), b = n . e_phi. Both
+  // are smooth in (u, phi) wherever the peak is, and their integrals over
+  // u along a ray from F are closed forms (polynomials in sin and cos, the
+  // part below the receiver's horizon clipped off), so only phi is summed:
+  // `angles` midpoints over the rays from F that meet the light (all of
+  // them where F lies on it, the light's span seen from F otherwise). Then
+  // v = A I2 / (h^2 I1^2) - 1 (I1, I2 the two integrals, A the light's
+  // area; I1 is Omega_proj). With 12 angles within 4 % of the exact v_area
+  // on the test receivers (tests/test_auto_strategy.cpp; 5.4 % with 8, at
+  // a receiver under the light with its normal across it).
+  // Double precision: A / h^2 is as large as the peak is narrow.
+  double peak_v_area(const vec3& o, const vec3& n, int angles = 12) const {
+    const double la = glm::length(E1_), lb = glm::length(E2_);
+    const glm::dvec3 u1 = glm::dvec3(E1_) / la, u2 = glm::dvec3(E2_) / lb, nl(nl_), nd(n);
+    const double ha = rect_ ? 0.5 * la : la, hb = rect_ ? 0.5 * lb : lb;  // half-extents (semi-axes)
+    const glm::dvec3 q = glm::dvec3(o) - glm::dvec3(center_);
+    const double h = glm::dot(q, nl);
+    if (!(h > 0.0)) return 0.0;
+    const double fx = glm::dot(q, u1), fy = glm::dot(q, u2);  // F in the light's frame
+    const double a = -glm::dot(nd, nl), nx = glm::dot(nd, u1), ny = glm::dot(nd, u2);
+    // The interval [r0, r1] of rho along direction (dx, dy) inside the light.
+    const auto chord = [&](double dx, double dy, double& r0, double& r1) {
+      if (rect_) {
+        r0 = 0.0, r1 = std::numeric_limits<double>::infinity();
+        for (const auto& [f, d, e] : {std::tuple{fx, dx, ha}, std::tuple{fy, dy, hb}}) {
+          if (d == 0.0) {
+            if (std::abs(f) > e) return false;
+            continue;
+          }
+          const double t0 = (-e - f) / d, t1 = (e - f) / d;
+          r0 = std::max(r0, std::min(t0, t1)), r1 = std::min(r1, std::max(t0, t1));
+        }
+        return r1 > r0;
+      }
+      const double A = dx * dx / (ha * ha) + dy * dy / (hb * hb), B = fx * dx / (ha * ha) + fy * dy / (hb * hb),
+                   C = fx * fx / (ha * ha) + fy * fy / (hb * hb) - 1.0;
+      const double disc = B * B - A * C;
+      if (!(disc > 0.0)) return false;
+      const double s = std::sqrt(disc);
+      r0 = std::max((-B - s) / A, 0.0), r1 = (-B + s) / A;
+      return r1 > r0;
+    };
+    // The directions from F that meet the light: every one where F is on
+    // it; otherwise those between the extreme directions to its corners
+    // (rectangle) or its tangent points (ellipse), as angles from the
+    // direction to its centre (the light is convex and F outside it, so
+    // they span less than pi).
+    // Where F is on the light the midpoints start at a direction in which
+    // the receiver's horizon crosses the plane (b = 0), so that with an even
+    // number of angles both such directions, where the clipped integrands
+    // have a kink in phi, fall between two midpoints' cells.
+    double phi0 = std::atan2(ny, nx) + 0.5 * std::numbers::pi, span = 2.0 * std::numbers::pi;
+    const bool inside = rect_ ? std::abs(fx) <= ha && std::abs(fy) <= hb : (fx * fx) / (ha * ha) + (fy * fy) / (hb * hb) <= 1.0;
+    if (!inside) {
+      const double c = std::atan2(-fy, -fx);
+      double lo = 0.0, hi = 0.0;
+      const auto extend = [&](double px, double py) {
+        double t = std::atan2(py - fy, px - fx) - c;
+        if (t > std::numbers::pi) t -= 2.0 * std::numbers::pi;
+        if (t < -std::numbers::pi) t += 2.0 * std::numbers::pi;
+        lo = std::min(lo, t), hi = std::max(hi, t);
+      };
+      if (rect_) {
+        for (const double sx : {-1.0, 1.0})
+          for (const double sy : {-1.0, 1.0}) extend(sx * ha, sy * hb);
+      } else {
+        // Tangent points (ha cos t, hb sin t): (fx / ha) cos t + (fy / hb) sin t = 1.
+        const double al = fx / ha, be = fy / hb, psi = std::atan2(be, al), w = std::acos(1.0 / std::hypot(al, be));
+        for (const double t : {psi - w, psi + w}) extend(ha * std::cos(t), hb * std::sin(t));
+      }
+      phi0 = c + lo, span = hi - lo;
+    }
+    // The integrals over u of cos+(theta) sin(u) and cos+(theta)^2 cos^3(u)
+    // sin(u) (their antiderivatives F1, F2).
+    const auto F1 = [&](double b, double u) {
+      const double s = std::sin(u);
+      return 0.5 * a * s * s + b * (0.5 * u - 0.25 * std::sin(2.0 * u));
+    };
+    const auto F2 = [&](double b, double u) {
+      const double c = std::cos(u), c2 = c * c, c4 = c2 * c2, c6 = c4 * c2, s2u = std::sin(2.0 * u);
+      const double cos4_sin2 = u / 16.0 - std::sin(4.0 * u) / 64.0 + s2u * s2u * s2u / 48.0;  // of cos^4 sin^2
+      return -a * a * c6 / 6.0 + 2.0 * a * b * cos4_sin2 + b * b * (c6 / 6.0 - c4 / 4.0);
+    };
+    double i1 = 0.0, i2 = 0.0;
+    const double dphi = span / angles;
+    for (int k = 0; k < angles; ++k) {
+      const double phi = phi0 + (k + 0.5) * dphi, dx = std::cos(phi), dy = std::sin(phi);
+      double r0, r1;
+      if (!chord(dx, dy, r0, r1)) continue;
+      const double b = nx * dx + ny * dy;
+      // cos(theta) = R cos(u - delta) > 0 for |u - delta| < pi / 2.
+      const double delta = std::atan2(b, a);
+      const double u0 = std::max(std::atan2(r0, h), delta - 0.5 * std::numbers::pi);
+      const double u1e = std::min(std::atan2(r1, h), delta + 0.5 * std::numbers::pi);
+      if (!(u1e > u0)) continue;
+      i1 += F1(b, u1e) - F1(b, u0), i2 += F2(b, u1e) - F2(b, u0);
+    }
+    i1 *= dphi, i2 *= dphi;
+    if (!(i1 > 0.0)) return 0.0;
+    return std::max(double(area_) * i2 / (h * h * i1 * i1) - 1.0, 0.0);
+  }
   auto_choice fine(const vec3& o, const vec3& n) const { return model(fine_, o, n); }
 
   // The choice: the delta method, where valid, then the coarse rule
@@ -518,12 +642,14 @@ class planar_rule {
     ch.set_sums(s.sg, s.sg2, s.sw, s.sg, s.swc2, resolved ? 0.0f : std::max(s.g_max, g_quad_max));
     ch.set_area_scale(area_ * h);
     // Where the points miss g's peak, the exact Omega_proj (a few hundred
-    // ns to a few us, at the few cells near the light where this happens);
-    // the fine rule's only (the coarse one's choice is never taken there:
+    // ns to a few us, at the few cells near the light where this happens)
+    // and v_area integrated about the peak (peak_v_area, 1-2 us); the
+    // fine rule's only (the coarse one's choice is never taken there:
     // area_wins_even_if).
     if (N == fine_points && ch.peaked()) {
       const double exact = std::visit([&](const auto& e) { return e.projected_solid_angle(o, n); }, exact_);
       if (exact > 0.0) ch.set_exact_omega_proj(static_cast<float>(exact), area_ * h);
+      ch.set_peak_v_area(static_cast<float>(peak_v_area(o, n)));
     }
     return ch;
   }
