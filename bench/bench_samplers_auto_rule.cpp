@@ -49,25 +49,21 @@ std::vector<receiver> far_receivers(const vec3& c, float half) {
 const rect bench_rect = bench::cornell_rect_light();
 const ellipse bench_ellipse = bench::cornell_disk_light();
 
-template <class Shape>
-void fine_model(benchmark::State& state, const Shape& s, const std::vector<receiver>& rs) {
+// f(rule, receiver) per iteration, over the receivers in turn.
+template <class Shape, class F>
+void over_receivers(benchmark::State& state, const Shape& s, const std::vector<receiver>& rs, F f) {
   const planar_rule rule(s);
   std::size_t i = 0;
-  for (auto _ : state) {
-    const receiver& r = rs[i++ & 63];
-    benchmark::DoNotOptimize(rule.fine(r.o, r.n).v_area());
-  }
+  for (auto _ : state) benchmark::DoNotOptimize(f(rule, rs[i++ & 63]));
   state.SetItemsProcessed(state.iterations());
 }
 template <class Shape>
+void fine_model(benchmark::State& state, const Shape& s, const std::vector<receiver>& rs) {
+  over_receivers(state, s, rs, [](const planar_rule& rule, const receiver& r) { return rule.fine(r.o, r.n).v_area(); });
+}
+template <class Shape>
 void peak_integral(benchmark::State& state, const Shape& s, const std::vector<receiver>& rs) {
-  const planar_rule rule(s);
-  std::size_t i = 0;
-  for (auto _ : state) {
-    const receiver& r = rs[i++ & 63];
-    benchmark::DoNotOptimize(rule.peak_v_area(r.o, r.n));
-  }
-  state.SetItemsProcessed(state.iterations());
+  over_receivers(state, s, rs, [](const planar_rule& rule, const receiver& r) { return rule.peak_v_area(r.o, r.n); });
 }
 
 void BM_AutoRuleRectNear(benchmark::State& st) { fine_model(st, bench_rect, near_receivers(bench_rect.center(), 65.0f)); }

@@ -245,6 +245,39 @@ void check_choice_gain_factor(sampler_kind kind) {
 TEST(ChoiceGainPilot, KappaSobol) { check_choice_gain_factor<sobol_sampler>(sampler_kind::sobol); }
 TEST(ChoiceGainPilot, KappaStratified) { check_choice_gain_factor<stratified_sampler>(sampler_kind::stratified); }
 
+// The settling tests' scene: a bare floor 0.3 under a rectangle light,
+// sampled by area until the test makes it `auto`, seen from above at 64 x
+// 64, 8 spp, direct light.
+struct settle_floor {
+  rect r = xz_rect(-0.6f, 0.6f, -0.4f, 0.4f, 0.3f, true);
+  camera cam{{0, 1.0f, -1.5f}, {0, 0, 0}, {0, 1, 0}, 60, 1.0f};
+  scene pilot_scene;
+  render_settings rs = settings(64, 64);
+  explicit settle_floor(sampler_kind kind) {
+    rs.spp = 8;
+    rs.sampler = kind;
+    rs.seed = 9;
+    pilot_scene.materials = {lambertian{color(0.5f)}, diffuse_light{color(4.0f)}};
+    pilot_scene.add(xz_rect_shape{-50, 50, -50, 50, 0}, 0);
+    pilot_scene.add_light(rect_area_sampler{r}, 1);
+    pilot_scene.ray_epsilon = 1e-4f;
+  }
+  // The light's `auto` params with the pilot's V.
+  static auto_params params(const noise_pilot_result& noise) {
+    auto_params p;
+    p.image_variance = static_cast<float>(noise.image_variance);
+    p.radiance = 4.0f;
+    p.albedo = 0.5f;
+    return p;
+  }
+  // The scene with its light sampled by `auto` with params p.
+  scene with_auto(const auto_params& p) const {
+    scene sc = pilot_scene;
+    sc.lights[0] = rect_auto_sampler(r, p);
+    return sc;
+  }
+};
+
 // settle_auto_lights on a bare floor under an `auto` rectangle (direct
 // light): with independent samples kappa is 1 and the rule sees V itself;
 // with Sobol samples kappa is in (0, 1) and V <= V_l = V (1 - (1 - kappa) s)
@@ -253,27 +286,14 @@ TEST(ChoiceGainPilot, KappaStratified) { check_choice_gain_factor<stratified_sam
 // (render/rest_cost.hpp), or left as given.
 TEST(ChoiceGainPilot, SettleWeighsEachAutoLight) {
   for (const sampler_kind kind : {sampler_kind::independent, sampler_kind::sobol}) {
-    const rect r = xz_rect(-0.6f, 0.6f, -0.4f, 0.4f, 0.3f, true);
-    render_settings rs = settings(64, 64);
-    rs.spp = 8;
-    rs.sampler = kind;
-    rs.seed = 9;
-    const camera cam({0, 1.0f, -1.5f}, {0, 0, 0}, {0, 1, 0}, 60, 1.0f);
-    scene pilot_scene;
-    pilot_scene.materials = {lambertian{color(0.5f)}, diffuse_light{color(4.0f)}};
-    pilot_scene.add(xz_rect_shape{-50, 50, -50, 50, 0}, 0);
-    pilot_scene.add_light(rect_area_sampler{r}, 1);
-    pilot_scene.ray_epsilon = 1e-4f;
-    const noise_pilot_result noise = estimate_image_variance(pilot_scene, cam, rs);
+    const settle_floor f(kind);
+    const render_settings& rs = f.rs;
+    const noise_pilot_result noise = estimate_image_variance(f.pilot_scene, f.cam, rs);
     ASSERT_GT(noise.image_variance, 0.0);
     ASSERT_EQ(noise.light_variance.size(), 1u);
-    auto_params p;
-    p.image_variance = static_cast<float>(noise.image_variance);
-    p.radiance = 4.0f;
-    p.albedo = 0.5f;
-    scene sc = pilot_scene;
-    sc.lights[0] = rect_auto_sampler(r, p);
-    const std::vector<auto_light_settlement> a = settle_auto_lights(sc, cam, rs, noise, 64);
+    const auto_params p = settle_floor::params(noise);
+    scene sc = f.with_auto(p);
+    const std::vector<auto_light_settlement> a = settle_auto_lights(sc, f.cam, rs, noise, 64);
     ASSERT_EQ(a.size(), 1u);
     EXPECT_EQ(a[0].light, 0u);
     EXPECT_EQ(a[0].rest_cost, modelled_rest_cost(noise.rays_per_light_sample, noise.paths_per_light_sample,
@@ -295,9 +315,8 @@ TEST(ChoiceGainPilot, SettleWeighsEachAutoLight) {
       EXPECT_GE(a[0].image_variance, v * (1.0 - 1e-6));
       EXPECT_LE(a[0].image_variance, v / a[0].kappa * (1.0 + 1e-6));
     }
-    scene fixed = pilot_scene;
-    fixed.lights[0] = rect_auto_sampler(r, p);
-    EXPECT_EQ(settle_auto_lights(fixed, cam, rs, noise, 64, false)[0].rest_cost, p.rest_cost);
+    scene fixed = f.with_auto(p);
+    EXPECT_EQ(settle_auto_lights(fixed, f.cam, rs, noise, 64, false)[0].rest_cost, p.rest_cost);
   }
 }
 
@@ -307,30 +326,16 @@ TEST(ChoiceGainPilot, SettleWeighsEachAutoLight) {
 // emission term set to 0, 0.3 and 0.9 of V gives s = min(max(measured,
 // modelled), 1 - V_E / V), and at 0.9 the cap is what sets it.
 TEST(ChoiceGainPilot, NoiseShareAtMostTheReflectedPart) {
-  const rect r = xz_rect(-0.6f, 0.6f, -0.4f, 0.4f, 0.3f, true);
-  render_settings rs = settings(64, 64);
-  rs.spp = 8;
-  rs.sampler = sampler_kind::sobol;
-  rs.seed = 9;
-  const camera cam({0, 1.0f, -1.5f}, {0, 0, 0}, {0, 1, 0}, 60, 1.0f);
-  scene pilot_scene;
-  pilot_scene.materials = {lambertian{color(0.5f)}, diffuse_light{color(4.0f)}};
-  pilot_scene.add(xz_rect_shape{-50, 50, -50, 50, 0}, 0);
-  pilot_scene.add_light(rect_area_sampler{r}, 1);
-  pilot_scene.ray_epsilon = 1e-4f;
-  const noise_pilot_result pilot = estimate_image_variance(pilot_scene, cam, rs);
+  const settle_floor fl(sampler_kind::sobol);
+  const noise_pilot_result pilot = estimate_image_variance(fl.pilot_scene, fl.cam, fl.rs);
   ASSERT_GT(pilot.image_variance, 0.0);
   bool capped = false;
   for (const double f : {0.0, 0.3, 0.9}) {
     noise_pilot_result noise = pilot;
     noise.edge_variance = f * noise.image_variance;
-    auto_params p;
-    p.image_variance = static_cast<float>(noise.image_variance);
-    p.radiance = 4.0f;
-    p.albedo = 0.5f;
-    scene sc = pilot_scene;
-    sc.lights[0] = rect_auto_sampler(r, p);
-    const std::vector<auto_light_settlement> a = settle_auto_lights(sc, cam, rs, noise, 64);
+    const auto_params p = settle_floor::params(noise);
+    scene sc = fl.with_auto(p);
+    const std::vector<auto_light_settlement> a = settle_auto_lights(sc, fl.cam, fl.rs, noise, 64);
     ASSERT_EQ(a.size(), 1u);
     ASSERT_LT(a[0].kappa, 1.0) << "the premise: kappa measured (the choice pays with V)";
     const double larger = std::max(a[0].noise_share_measured, a[0].noise_share_model);
