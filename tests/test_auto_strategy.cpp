@@ -250,6 +250,39 @@ TEST(AutoStrategy, PeakVarianceIntegrated) {
   EXPECT_EQ(peaked, 12) << "every receiver here is one where g peaks between the rule's points";
 }
 
+// Receivers all but touching a planar light, 1e-3 to 1e-42 of its size
+// under its middle (down to a subnormal height), facing it and with the
+// normal across it: the model stays finite and lit (there 1 / r^4 at the
+// peak's candidates overflows a float, or r^2 underflows, and a weight 0
+// times infinity made every sum NaN: the disk's receivers below 1e-10
+// looked unlit and took area sampling). Its Omega_proj is within 2 % of
+// the half-space's (pi facing, pi / 2 across), v_area is positive and at
+// most the largest float, and the choice is a dearer strategy than area
+// sampling (v_area is huge there).
+TEST(AutoStrategy, ModelFiniteWhereReceiverTouchesLight) {
+  auto_params p;
+  p.image_variance = 0.01f;
+  for (const float h : {1e-3f, 1e-10f, 1e-15f, 1e-20f, 1e-30f, 1e-38f, 1e-42f}) {
+    for (const bool disk : {false, true}) {
+      const planar_rule rule = disk ? planar_rule(unit_disk()) : planar_rule(unit_rect());
+      for (const vec3 n : {vec3(0, 1, 0), vec3(1, 0, 0)}) {
+        const vec3 o(0.1f, -h, 0.05f);
+        char name_c[64];
+        std::snprintf(name_c, sizeof name_c, "h = %g, %s, %s", h, disk ? "disk" : "rect", n.x > 0.0f ? "across" : "facing");
+        const std::string name = name_c;
+        const auto_choice m = rule.fine(o, n);
+        ASSERT_TRUE(m.peaked()) << name;
+        const double half_space = n.x > 0.0f ? std::numbers::pi / 2.0 : std::numbers::pi;
+        EXPECT_NEAR(m.omega_proj(), half_space, 0.02 * half_space) << name;
+        EXPECT_GT(m.v_area(), 0.0f) << name;
+        EXPECT_LE(m.v_area(), std::numeric_limits<float>::max()) << name;
+        EXPECT_TRUE(std::isfinite(m.v_solid_angle())) << name;
+        EXPECT_NE(rule.choose(o, n, p), light_sampling::area) << name;
+      }
+    }
+  }
+}
+
 TEST(AutoStrategy, ModelVariancesRect) { check_model<rect, rect_area_sampler, rect_solid_angle_sampler>(unit_rect()); }
 TEST(AutoStrategy, ModelVariancesDisk) {
   check_model<ellipse, ellipse_area_sampler, ellipse_solid_angle_sampler>(unit_disk());

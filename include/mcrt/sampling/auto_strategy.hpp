@@ -238,14 +238,23 @@ class auto_choice {
   float v_area() const {
     if (!(sg_ > 0.0f)) return 0.0f;
     if (peaked() && v_peak_ >= 0.0f) return v_peak_;
-    const float v = std::max(sg2_ / (sg_ * sg_) - 1.0f, 0.0f);
+    const float v = excess_ratio(sg2_, 1.0f, sg_);
     const float mean = mean_g_ > 0.0f ? mean_g_ : sg_;
     return peaked() ? std::max(v, (g_peak_ / mean - 1.0f) * (1.0f / 3.0f)) : v;
   }
   bool peaked() const { return g_peak_ > 2.0f * sg_; }
   float v_solid_angle() const {
     if (!(swc_ > 0.0f)) return 0.0f;
-    return std::max(sw_ * swc2_ / (swc_ * swc_) - 1.0f, 0.0f);
+    return excess_ratio(sw_, swc2_, swc_);
+  }
+  // a b / d^2 - 1, at least 0 (d > 0): in float, or in double where d^2
+  // underflows a float (the sums leave out h, the receiver's height over a
+  // planar light, but for a receiver facing it g / h still scales with h:
+  // below about 1e-19 of the light's size d^2 would be 0 and the ratio NaN).
+  static float excess_ratio(float a, float b, float d) {
+    const float d2 = d * d;
+    if (d2 >= std::numeric_limits<float>::min()) return std::max(a * b / d2 - 1.0f, 0.0f);
+    return static_cast<float>(std::max(double(a) * b / (double(d) * d) - 1.0, 0.0));
   }
 
   // Whether area sampling is the choice even with v_area and v_sa taken
@@ -433,7 +442,8 @@ class planar_rule {
   // on the test receivers (tests/test_auto_strategy.cpp; 5.4 % with 8, at
   // a receiver under the light with its normal across it).
   // Double precision: A / h^2 is as large as the peak is narrow.
-  double peak_v_area(const vec3& o, const vec3& n, int angles = 12) const {
+  // omega_proj, where given, receives I1 (the light's projected solid angle).
+  double peak_v_area(const vec3& o, const vec3& n, double* omega_proj = nullptr, int angles = 12) const {
     const double la = glm::length(E1_), lb = glm::length(E2_);
     const glm::dvec3 u1 = glm::dvec3(E1_) / la, u2 = glm::dvec3(E2_) / lb, nl(nl_), nd(n);
     const double ha = rect_ ? 0.5 * la : la, hb = rect_ ? 0.5 * lb : lb;  // half-extents (semi-axes)
@@ -464,15 +474,15 @@ class planar_rule {
       r0 = std::max((-B - s) / A, 0.0), r1 = (-B + s) / A;
       return r1 > r0;
     };
-    // The directions from F that meet the light: every one where F is on
-    // it; otherwise those between the extreme directions to its corners
+    // The directions from F that meet the light, phi0 to phi0 + span:
+    // every one where F is on it, the midpoints starting at a direction in
+    // which the receiver's horizon crosses the plane (b = 0), so that with
+    // an even number of angles both such directions, where the clipped
+    // integrands have a kink in phi, fall between two midpoints' cells;
+    // otherwise those between the extreme directions to its corners
     // (rectangle) or its tangent points (ellipse), as angles from the
     // direction to its centre (the light is convex and F outside it, so
     // they span less than pi).
-    // Where F is on the light the midpoints start at a direction in which
-    // the receiver's horizon crosses the plane (b = 0), so that with an even
-    // number of angles both such directions, where the clipped integrands
-    // have a kink in phi, fall between two midpoints' cells.
     double phi0 = std::atan2(ny, nx) + 0.5 * std::numbers::pi, span = 2.0 * std::numbers::pi;
     const bool inside = rect_ ? std::abs(fx) <= ha && std::abs(fy) <= hb : (fx * fx) / (ha * ha) + (fy * fy) / (hb * hb) <= 1.0;
     if (!inside) {
@@ -520,6 +530,7 @@ class planar_rule {
       i1 += F1(b, u1e) - F1(b, u0), i2 += F2(b, u1e) - F2(b, u0);
     }
     i1 *= dphi, i2 *= dphi;
+    if (omega_proj) *omega_proj = i1;
     if (!(i1 > 0.0)) return 0.0;
     return std::max(double(area_) * i2 / (h * h * i1 * i1) - 1.0, 0.0);
   }
@@ -568,6 +579,11 @@ class planar_rule {
   // weights of the peak's candidates are 0): the terms of
   // auto_choice::set_sums, and the largest g / h. Packed (SSE) where
   // available: one division and one square root for the four.
+  // g, w and cos+(theta) are clamped to the largest float (NaN too): for
+  // a point of the light within about 1e-10 of its size from o (the peak's
+  // candidates right under o, h tiny) 1 / r^4 overflows, or r^2 underflows
+  // to 0, and a candidate's weight 0 times infinity would make every sum
+  // NaN (and the receiver look unlit).
   struct sums {
     float sg = 0.0f, sg2 = 0.0f, sw = 0.0f, swc2 = 0.0f, g_max = 0.0f;
   };
@@ -582,14 +598,17 @@ class planar_rule {
                    _mm_mul_ps(dz, _mm_set1_ps(n.z))),
         _mm_setzero_ps());
     const __m128 inv_r2 = _mm_div_ps(_mm_set1_ps(1.0f), r2), inv_r = _mm_sqrt_ps(inv_r2);
-    const __m128 g = _mm_mul_ps(dn, _mm_mul_ps(inv_r2, inv_r2));  // g / h
-    const __m128 w = _mm_mul_ps(inv_r2, inv_r);                    // solid angle per unit area / h
+    // (minps returns its second operand where the first is NaN.)
+    const __m128 big = _mm_set1_ps(std::numeric_limits<float>::max());
+    const __m128 g = _mm_min_ps(_mm_mul_ps(dn, _mm_mul_ps(inv_r2, inv_r2)), big);  // g / h
+    const __m128 w = _mm_min_ps(_mm_mul_ps(inv_r2, inv_r), big);  // solid angle per unit area / h
+    const __m128 c = _mm_min_ps(_mm_mul_ps(dn, inv_r), big);  // cos+(theta)
     const __m128 W = _mm_loadu_ps(wt), Wg = _mm_mul_ps(W, g);
     alignas(16) float t[4][4];
     _mm_store_ps(t[0], Wg);
     _mm_store_ps(t[1], _mm_mul_ps(Wg, g));
     _mm_store_ps(t[2], _mm_mul_ps(W, w));
-    _mm_store_ps(t[3], _mm_mul_ps(Wg, _mm_mul_ps(dn, inv_r)));  // W g cos+(theta)
+    _mm_store_ps(t[3], _mm_mul_ps(Wg, c));  // W g cos+(theta)
     alignas(16) float gm[4];
     _mm_store_ps(gm, g);
     s.sg += (t[0][0] + t[0][1]) + (t[0][2] + t[0][3]);
@@ -603,8 +622,10 @@ class planar_rule {
       const float r2 = dx * dx + dy * dy + dz * dz;
       const float dn = std::max(dx * n.x + dy * n.y + dz * n.z, 0.0f);
       const float inv_r2 = 1.0f / r2, inv_r = std::sqrt(inv_r2);
-      const float g = dn * inv_r2 * inv_r2, w = inv_r2 * inv_r;
-      s.sg += wt[i] * g, s.sg2 += wt[i] * g * g, s.sw += wt[i] * w, s.swc2 += wt[i] * g * dn * inv_r;
+      constexpr float big = std::numeric_limits<float>::max();  // fmin: the other operand where one is NaN
+      const float g = std::fmin(dn * inv_r2 * inv_r2, big), w = std::fmin(inv_r2 * inv_r, big);
+      const float c = std::fmin(dn * inv_r, big);
+      s.sg += wt[i] * g, s.sg2 += wt[i] * g * g, s.sw += wt[i] * w, s.swc2 += wt[i] * g * c;
       s.g_max = std::max(s.g_max, g);
     }
 #endif
@@ -647,9 +668,18 @@ class planar_rule {
     // fine rule's only (the coarse one's choice is never taken there:
     // area_wins_even_if).
     if (N == fine_points && ch.peaked()) {
+      double omega_peak = 0.0;
+      const double v = peak_v_area(o, n, &omega_peak);
+      // The sampler's exact Omega_proj; where it is not finite (the
+      // ellipse's, for o within about 1e-10 of its size from its plane),
+      // the peak integral's I1 (12 angles, as its v_area).
       const double exact = std::visit([&](const auto& e) { return e.projected_solid_angle(o, n); }, exact_);
-      if (exact > 0.0) ch.set_exact_omega_proj(static_cast<float>(exact), area_ * h);
-      ch.set_peak_v_area(static_cast<float>(peak_v_area(o, n)));
+      const double omega = exact > 0.0 && std::isfinite(exact) ? exact : omega_peak;
+      if (omega > 0.0) ch.set_exact_omega_proj(static_cast<float>(omega), area_ * h);
+      // At most the largest float: A / h^2 overflows it where o all but
+      // touches the light (h below about 1e-19 of its size), and v_area
+      // enters the rule's float scores.
+      ch.set_peak_v_area(static_cast<float>(std::min(v, double(std::numeric_limits<float>::max()))));
     }
     return ch;
   }
