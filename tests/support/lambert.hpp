@@ -28,6 +28,30 @@ inline double polygon_irradiance(const glm::dvec3& x, const glm::dvec3& n, const
   return std::abs(0.5 * L * sum);
 }
 
+// The part of a convex polygon on the side of the plane through x with
+// normal n that n points into (Sutherland & Hodgman 1974, one plane): what a
+// receiver at x with normal n sees of a light that its horizon cuts. The
+// vertex order is kept, so the winding rule above still holds.
+inline std::vector<glm::dvec3> clip_to_horizon(const glm::dvec3& x, const glm::dvec3& n,
+                                               const std::vector<glm::dvec3>& poly) {
+  std::vector<glm::dvec3> out;
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const glm::dvec3 &a = poly[i], &b = poly[(i + 1) % poly.size()];
+    const double da = glm::dot(a - x, n), db = glm::dot(b - x, n);
+    if (da >= 0.0) out.push_back(a);
+    if ((da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0)) out.push_back(a + (b - a) * (da / (da - db)));
+  }
+  return out;
+}
+
+// Irradiance at x (normal n) from a convex polygon of radiance L partly
+// behind x's horizon: Lambert's formula over the part in front.
+inline double clipped_polygon_irradiance(const glm::dvec3& x, const glm::dvec3& n, const std::vector<glm::dvec3>& poly,
+                                         double L) {
+  const std::vector<glm::dvec3> front = clip_to_horizon(x, n, poly);
+  return front.size() < 3 ? 0.0 : polygon_irradiance(x, n, front, L);
+}
+
 // Irradiance on a plane parallel to a disk of radius R and radiance L, at
 // height h below it and horizontal distance d from its axis (e.g. Howell's
 // catalogue of configuration factors, C-13):

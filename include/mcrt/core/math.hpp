@@ -36,6 +36,14 @@ inline T safe_asin(T x) { return std::asin(std::clamp(x, T(-1), T(1))); }
 template <class T>
 inline T safe_acos(T x) { return std::acos(std::clamp(x, T(-1), T(1))); }
 
+// Bound on the relative error of n successive float roundings, n u / (1 - n u)
+// with u = 2^-24 the unit roundoff (Higham 2002, sec. 3.1; pbrt-v4's Gamma):
+// the factor of the conservative error bounds of computed hit points.
+constexpr float rounding_gamma(int n) {
+  constexpr float u = 0x1p-24f;
+  return (static_cast<float>(n) * u) / (1.0f - static_cast<float>(n) * u);
+}
+
 inline bool all_finite(const vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }

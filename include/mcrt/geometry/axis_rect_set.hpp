@@ -32,23 +32,36 @@ struct any_axis_rect {
   }
 };
 
-// The rectangle as an axis-aligned one, if its normal is a coordinate axis
-// (then both edges lie along the other two axes).
+// The rectangle as an axis-aligned one, if both its edges lie exactly along
+// coordinate axes (each edge has one non-zero component, the two along
+// different axes); nullopt for every other rectangle. A normal along an axis
+// is not enough: a rectangle turned in a coordinate plane has one, and its
+// extent is not the box from corner to corner + e1 + e2.
 inline std::optional<any_axis_rect> as_axis_rect(const rect& r, std::uint32_t material) {
-  for (int axis = 0; axis < 3; ++axis) {
-    const int a = (axis + 1) % 3, b = (axis + 2) % 3;
-    if (r.n[a] != 0.0f || r.n[b] != 0.0f) continue;
-    const vec3 far = r.corner + r.e1 + r.e2;
-    return any_axis_rect{axis,
-                         std::min(r.corner[a], far[a]),
-                         std::max(r.corner[a], far[a]),
-                         std::min(r.corner[b], far[b]),
-                         std::max(r.corner[b], far[b]),
-                         r.corner[axis],
-                         r.n[axis] < 0.0f,
-                         material};
-  }
-  return std::nullopt;
+  // The axis an edge lies along, or -1 where it has more than one non-zero
+  // component (or none).
+  const auto along = [](const vec3& e) {
+    int axis = -1;
+    for (int i = 0; i < 3; ++i) {
+      if (e[i] == 0.0f) continue;
+      if (axis >= 0) return -1;
+      axis = i;
+    }
+    return axis;
+  };
+  const int i1 = along(r.e1), i2 = along(r.e2);
+  if (i1 < 0 || i2 < 0 || i1 == i2) return std::nullopt;
+  const int axis = 3 - i1 - i2;  // the normal's axis
+  const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+  const vec3 far = r.corner + r.e1 + r.e2;  // exact along a and b: one edge adds to each
+  return any_axis_rect{axis,
+                       std::min(r.corner[a], far[a]),
+                       std::max(r.corner[a], far[a]),
+                       std::min(r.corner[b], far[b]),
+                       std::max(r.corner[b], far[b]),
+                       r.corner[axis],
+                       r.n[axis] < 0.0f,
+                       material};
 }
 
 class axis_rect_set {

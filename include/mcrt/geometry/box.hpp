@@ -33,8 +33,13 @@ struct box {
 
   // The hit record of a hit at t found by intersect(): the face is the one
   // whose plane the local hit point is nearest to, relative to the box size.
+  // The hit point is that local point moved onto the face's plane exactly,
+  // then to the world, with the bound of that transform's rounding as the
+  // record's offset: the ray's own point o + t d may lie inside the box by
+  // its rounding (1e-5 of a 500-unit scene), and a ray leaving a face at a
+  // grazing angle from there would meet the box again past t_min.
   void surface(const ray& world_ray, float t, hit_record& rec) const {
-    const vec3 p = xf.to_local(world_ray.at(t));
+    vec3 p = xf.to_local(world_ray.at(t));
     const vec3 size = hi - lo;
     const vec3 dlo = glm::abs(p - lo) / size, dhi = glm::abs(p - hi) / size;
     int axis = 0;
@@ -45,9 +50,11 @@ struct box {
     }
     vec3 local_n(0.0f);
     local_n[axis] = sign;
+    p[axis] = sign < 0.0f ? lo[axis] : hi[axis];
     rec.t = t;
-    rec.p = world_ray.at(t);
+    rec.p = xf.to_world(p);
     const vec3 outward = xf.rotate(local_n);
+    rec.offset = glm::dot(glm::abs(outward), xf.to_world_error(p));
     rec.n = flip ? -outward : outward;
     rec.front_face = glm::dot(world_ray.d, rec.n) < 0.0f;
   }

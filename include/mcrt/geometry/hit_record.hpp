@@ -13,9 +13,20 @@ struct hit_record {
   float t = 0.0f;     // ray parameter of the hit
   std::uint32_t material = 0;
   bool front_face = true;  // the ray arrives at the front side: dot(d, n) < 0
+  // A bound on how far the computed p may lie from the true surface along
+  // n (the rounding of its computation, dot(|n|, error bound of p)), or 0
+  // where the shape gives none: a ray leaving the surface starts this far off
+  // it on the side it leaves to (spawn_origin), so that it cannot meet the
+  // surface it leaves (Pharr et al., "Physically Based Rendering", 4th ed.,
+  // sec. 6.8.6). Rays also start past the scene's t_min (scene::ray_epsilon).
+  float offset = 0.0f;
 
   // The unit normal on the side the ray came from (shading normal).
   vec3 facing_normal() const { return front_face ? n : -n; }
+
+  // The origin of a ray leaving p along dir: p moved off the surface by
+  // `offset` to the side dir points into (pbrt-v4's OffsetRayOrigin).
+  vec3 spawn_origin(const vec3& dir) const { return p + (glm::dot(dir, n) < 0.0f ? -offset : offset) * n; }
 };
 
 }  // namespace mcrt

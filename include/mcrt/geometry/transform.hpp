@@ -24,6 +24,16 @@ struct rigid_y {
     return {cos_t * v.x - sin_t * v.z, v.y, sin_t * v.x + cos_t * v.z};
   }
   vec3 to_world(const vec3& p) const { return rotate(p) + offset; }
+  // A bound on the rounding error of each component of to_world(p): two
+  // products, a sum and the offset's sum per component, gamma(3) of the
+  // terms' magnitudes (pbrt-v4's Transform applied with error), with one
+  // more rounding for the float cosine and sine, whose rotation is not
+  // exactly orthogonal.
+  vec3 to_world_error(const vec3& p) const {
+    const float g = rounding_gamma(4);
+    return g * vec3(std::abs(cos_t * p.x) + std::abs(sin_t * p.z) + std::abs(offset.x), std::abs(p.y) + std::abs(offset.y),
+                    std::abs(sin_t * p.x) + std::abs(cos_t * p.z) + std::abs(offset.z));
+  }
   vec3 to_local(const vec3& p) const { return unrotate(p - offset); }
   ray to_local(const ray& r) const { return {to_local(r.o), unrotate(r.d)}; }
 };
@@ -38,11 +48,14 @@ struct transformed {
     return shape.intersect(xf.to_local(r), tmin, tmax, t);
   }
 
-  // The hit record of a hit at t, moved back to the world.
+  // The hit record of a hit at t, moved back to the world. The world point
+  // is the ray's at t, with no error bound (offset 0: rays leaving it rely
+  // on the scene's t_min).
   void surface(const ray& r, float t, hit_record& rec) const {
     shape.surface(xf.to_local(r), t, rec);
     rec.p = r.at(t);
     rec.n = xf.rotate(rec.n);
+    rec.offset = 0.0f;
   }
 
   bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {

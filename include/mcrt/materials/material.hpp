@@ -72,7 +72,7 @@ inline bool scatter(const metal& m, const ray& in, const hit_record& rec, Ball&&
   const vec3 n = rec.facing_normal();
   vec3 d = glm::reflect(glm::normalize(in.d), n);
   if (m.fuzz > 0.0f) d += m.fuzz * ball();
-  out.r = {rec.p, d};
+  out.r = {rec.spawn_origin(d), d};
   out.attenuation = m.albedo;
   return glm::dot(d, n) > 0.0f;
 }
@@ -95,7 +95,7 @@ inline bool scatter(const dielectric& m, const ray& in, const hit_record& rec, U
     const vec3 perp = eta * (unit + cos_t * n);
     d = perp - safe_sqrt(1.0f - glm::dot(perp, perp)) * n;
   }
-  out.r = {rec.p, d};
+  out.r = {rec.spawn_origin(d), d};
   out.attenuation = color(1.0f);
   return true;
 }

@@ -111,10 +111,11 @@ double choice_gain_factor_with(const Scene& sc, const camera& cam, const render_
     const auto* lam = std::get_if<lambertian>(&sc.materials[rec.material]);
     if (!lam) return 0.0;
     const vec3 nf = rec.facing_normal();
+    const vec3 p = rec.spawn_origin(nf);
     const vec2 u = px.get2d(dim);
     light_sample lc, la;
-    const double fc = light_estimate(sc, s.sample_cheapest(rec.p, u, lc), lc, rec.p, nf);
-    const double fa = light_estimate(sc, s.sample(rec.p, nf, u, la), la, rec.p, nf);
+    const double fc = light_estimate(sc, s.sample_cheapest(p, u, lc), lc, p, nf);
+    const double fa = light_estimate(sc, s.sample(p, nf, u, la), la, p, nf);
     return (double(lam->albedo.r) + lam->albedo.g + lam->albedo.b) / 3.0 * inv_pi * (fc - fa);
   }, 1024);  // two light samples and shadow rays each: about 250 ns
 }

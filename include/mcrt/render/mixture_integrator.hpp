@@ -40,8 +40,9 @@ struct mixture_integrator {
 
       if (const auto* lam = std::get_if<lambertian>(&m)) {
         const vec3 n = rec.facing_normal();
+        const vec3 origin = rec.spawn_origin(n);  // the sampled directions leave on the facing side
         const cosine_pdf cos_pdf(n);
-        const light_pdf<light> lights(sc.lights, rec.p, n);
+        const light_pdf<light> lights(sc.lights, origin, n);
         const mixture_pdf<light> mix(cos_pdf, lights);
         const float u_select = ps.get1d(b + layout::light_choice);
         const bool from_cosine = lights.empty() || u_select < 0.5f;
@@ -53,7 +54,7 @@ struct mixture_integrator {
         // Below the surface the scattering pdf is 0: the path carries nothing more.
         if (!(cos_theta > 0.0f) || !(p > 0.0f)) break;
         throughput *= lam->albedo * (cos_theta * inv_pi / p);
-        r = {rec.p, dir};
+        r = {origin, dir};
         continue;
       }
 

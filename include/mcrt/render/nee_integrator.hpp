@@ -90,8 +90,10 @@ struct next_event_integrator {
 
       if (const auto* lam = std::get_if<lambertian>(&m)) {
         const vec3 n = rec.facing_normal();
-        const light_selection sel(sc, rec.p, n, set.choose);
-        radiance += throughput * sample_direct_light<Weights>(sc, rec.p, n, lam->albedo, sel, ps, b, set);
+        // Light samples and the continuation leave on the facing side.
+        const vec3 p = rec.spawn_origin(n);
+        const light_selection sel(sc, p, n, set.choose);
+        radiance += throughput * sample_direct_light<Weights>(sc, p, n, lam->albedo, sel, ps, b, set);
         if (depth >= set.rr_depth && !survive_roulette(throughput, [&] { return ps.get1d(b + layout::roulette); }))
           break;
         // The last scattering event of a plain next-event estimator: the
@@ -107,7 +109,7 @@ struct next_event_integrator {
         after_diffuse = true;
         prev_sel = sel;
         prev_p_material = cos_theta * inv_pi;
-        r = {rec.p, dir};
+        r = {p, dir};
         continue;
       }
 

@@ -484,16 +484,17 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
           const auto* lam = std::get_if<lambertian>(&sc.materials[rec1.material]);
           if (!lam) continue;
           const vec3 nf = rec1.facing_normal();
-          const light_selection sel(sc, rec1.p, nf, set.choose);
+          const vec3 p1 = rec1.spawn_origin(nf);
+          const light_selection sel(sc, p1, nf, set.choose);
           const double a = (double(lam->albedo.r) + lam->albedo.g + lam->albedo.b) / 3.0 * inv_pi;
           for (std::size_t l = 0; l < nl; ++l) {
             const double prob = sel.probability(l);
             if (!(prob > 0.0)) continue;
             light_sample s1, s2;
-            const bool ok1 = sample(sc.lights[l], rec1.p, nf, px.stream().uniform2(), s1);
-            const double f1 = light_estimate(sc, ok1, s1, rec1.p, nf);
-            const bool ok2 = sample(sc.lights[l], rec1.p, nf, px.stream().uniform2(), s2);
-            const double f2 = light_estimate(sc, ok2, s2, rec1.p, nf);
+            const bool ok1 = sample(sc.lights[l], p1, nf, px.stream().uniform2(), s1);
+            const double f1 = light_estimate(sc, ok1, s1, p1, nf);
+            const bool ok2 = sample(sc.lights[l], p1, nf, px.stream().uniform2(), s2);
+            const double f2 = light_estimate(sc, ok2, s2, p1, nf);
             row_lights[static_cast<std::size_t>(j)][l] += b.weight * a * a * 0.5 * (f1 - f2) * (f1 - f2) / prob;
           }
         }

@@ -58,8 +58,9 @@ struct basic_scene {
     axis_rects.add(s, material_index);
   }
 
-  // A rectangle whose edges lie along coordinate axes joins the fast
-  // axis-aligned set; any other is kept as a general rectangle.
+  // A rectangle whose two edges lie exactly along coordinate axes joins the
+  // fast axis-aligned set (as_axis_rect); any other, including one turned in
+  // a coordinate plane, is kept as a general rectangle.
   void add(const rect& r, std::uint32_t material_index) {
     note_material(material_index);
     add_geometry(r, material_index);
