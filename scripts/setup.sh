@@ -20,9 +20,10 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-# Python for scripts/ (the error-vs-time study, its plots and its Dask backend).
+# Python for scripts/ (the error-vs-time study, its plots and its Dask backend)
+# and for the documentation check (cffconvert validates CITATION.cff).
 # An existing .venv that lacks a package is upgraded in place.
-if [ ! -x .venv/bin/python ] || ! .venv/bin/python -c "import numpy, matplotlib, distributed" 2>/dev/null; then
+if [ ! -x .venv/bin/python ] || [ ! -x .venv/bin/cffconvert ] || ! .venv/bin/python -c "import numpy, matplotlib, distributed" 2>/dev/null; then
   echo "setup: installing scripts/requirements.txt into .venv" >&2
   [ -x .venv/bin/python ] || python3 -m venv .venv
   .venv/bin/pip install -q --disable-pip-version-check --upgrade -r scripts/requirements.txt

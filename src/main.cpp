@@ -1,4 +1,4 @@
-// The mcrt executable: `mcrt render`, `mcrt diff` and `mcrt samples` (shared/spec cli.md).
+// The mcrt executable: `mcrt render`, `mcrt diff` and `mcrt samples` (docs/cli.md).
 #include <cmath>
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -24,7 +24,7 @@ using namespace mcrt::cli;
 
 struct render_options {
   std::string scene, output, stats, light_sampling, ellipse_map = "parallel";
-  std::string integrator = "mixture", sampler = "sobol", mis_heuristic = "power", light_select = "power";
+  std::string integrator = "mis", sampler = "sobol", mis_heuristic = "power", light_select = "power";
   std::optional<int> spp, width, height, max_depth, rr_depth;
   std::optional<unsigned> threads;
   std::optional<float> auto_rest_cost, auto_rest_variance;
@@ -256,6 +256,7 @@ int run_diff(const diff_options& opt) {
 int main(int argc, char** argv) {
   CLI::App app{"mcrt: a Monte-Carlo path tracer for comparing direct sampling of area lights"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("mcrt ") + MCRT_VERSION);
 
   render_options ro;
   CLI::App* render_cmd = app.add_subcommand("render", "Render a scene file to an image");
@@ -269,8 +270,11 @@ int main(int argc, char** argv) {
                          "Scattering events before Russian roulette starts (default 1; >= max depth: off)");
   render_cmd->add_option("--seed", ro.seed, "Random seed (default 0)");
   render_cmd->add_option("--threads", ro.threads, "Threads (default: all hardware threads)");
-  render_cmd->add_option("--light-sampling", ro.light_sampling, "Sample every light by area, solid-angle, projected-solid-angle (cosine-aware) or "
-                         "bilinear-solid-angle (comparison: bilinear cosine pre-warp)")
+  render_cmd->add_option("--light-sampling", ro.light_sampling,
+                         "Sample every light by area, solid-angle, projected-solid-angle (cosine-aware), "
+                         "bilinear-solid-angle (comparison: bilinear cosine pre-warp) or auto (per light and shading "
+                         "point, the strategy expected to pay best) (default: each light's own; area for rectangles "
+                         "and ellipses, solid-angle for spheres)")
       ->check(CLI::IsMember({"area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle", "auto"}));
   render_cmd->add_option("--auto-rest-cost", ro.auto_rest_cost,
                          "--light-sampling auto: the rest of the path's time per light sample, ns (default: modelled from the "
@@ -282,8 +286,8 @@ int main(int argc, char** argv) {
                          "Map of the spherical ellipse for ellipses sampled by solid angle (default parallel)")
       ->check(CLI::IsMember({"parallel", "polar"}));
   render_cmd->add_option("--integrator", ro.integrator,
-                         "Estimator: mixture (Shirley's mixture pdf, default), nee (next-event estimation) or mis "
-                         "(next-event estimation with multiple importance sampling)")
+                         "Estimator: mis (next-event estimation with multiple importance sampling, default), nee "
+                         "(next-event estimation) or mixture (Shirley's mixture pdf, the seed's estimator)")
       ->check(CLI::IsMember({"mixture", "nee", "mis"}));
   render_cmd->add_option("--sampler", ro.sampler, "Sample generator: independent, stratified or sobol (default: sobol)")
       ->check(CLI::IsMember({"independent", "stratified", "sobol"}));
@@ -325,6 +329,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::string msg = e.what();

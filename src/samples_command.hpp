@@ -1,6 +1,6 @@
 #pragma once
 // `mcrt samples`: N independent samples of one light's strategy, as seen from
-// a point with a normal, written as CSV (shared/spec cli.md).
+// a point with a normal, written as CSV (docs/cli.md).
 #include <cstdint>
 #include <string>
 

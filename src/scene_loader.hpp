@@ -1,5 +1,5 @@
 #pragma once
-// Reads a scene file (shared/spec scene-format contract) into an mcrt::scene.
+// Reads a scene file (the contract of scenes/FORMAT.md) into an mcrt::scene.
 // Every violation of the contract throws input_error with one line naming
 // the file, the place in it and what is wrong.
 #include <optional>

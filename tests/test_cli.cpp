@@ -1,5 +1,5 @@
-// The mcrt executable against its contract (shared/spec cli.md and
-// scene-format.md): outputs, stats, diff, determinism across thread counts,
+// The mcrt executable against its contract (docs/cli.md and
+// scenes/FORMAT.md): outputs, stats, diff, determinism across thread counts,
 // and bad input: one line naming the file and the place, exit status 2, no
 // output file created or touched.
 #include <gtest/gtest.h>
@@ -120,6 +120,8 @@ TEST_F(Cli, RendersEveryFormatWithStats) {
     EXPECT_EQ(j["width"], 16);
     EXPECT_EQ(j["height"], 12);
     EXPECT_EQ(j["light_sampling"], "area");
+    EXPECT_EQ(j["integrator"], "mis") << "the default integrator (contract cli.md)";
+    EXPECT_EQ(j["sampler"], "sobol");
     EXPECT_NEAR(j["samples_per_second"].get<double>(), 16.0 * 12 * 2 / j["render_seconds"].get<double>(), 1e-6 * j["samples_per_second"].get<double>());
   }
   // EXR header attributes: render time and spp (attribute names are plain text in the header).
@@ -128,6 +130,13 @@ TEST_F(Cli, RendersEveryFormatWithStats) {
   EXPECT_NE(exr.find("mcrt:spp"), std::string::npos);
   // PPM: Shirley's plain format.
   EXPECT_EQ(slurp(dir / "img.ppm").rfind("P3\n16 12\n255\n", 0), 0u);
+}
+
+TEST_F(Cli, VersionPrintsTheProjectVersion) {
+  const result r = run("--version");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, std::string("mcrt ") + MCRT_VERSION + "\n");
+  EXPECT_TRUE(r.err.empty()) << r.err;
 }
 
 TEST_F(Cli, FlagsOverrideTheScene) {

@@ -12,7 +12,7 @@
 // and Sobol generators) of n samples each; the check is |mean - exact| <= 6
 // standard errors of the mean of the replicate means (Student t with 31
 // degrees of freedom: two-sided false-failure probability 1.2e-6 per check,
-// below 5e-4 for the 405 checks of this file), and additionally within 1 %
+// below 1e-3 for the 765 checks of this file), and additionally within 1 %
 // of the exact value, so a large standard error cannot hide a bias.
 // Replicates, not the spread of single samples, give the standard error:
 // the samples of one stratified or Sobol pixel are not independent. Where

@@ -1,15 +1,14 @@
 #pragma once
 // What the image's sample generator leaves of what `auto`'s choice gains,
 // measured per light before rendering; with it each light's rule sees the
-// image's noise as the image's own samples leave it (README, "Choosing per
-// shading point").
+// image's noise as the image's own samples leave it (docs/auto.md).
 //
 // The rule models a light sample's variance with independent samples (v_s),
 // and the pilot's V (render/noise_pilot.hpp) is an independent-sample
 // variance too, except for its emission term (kappa_E). A pixel's N light
 // samples from a stratified or Owen-scrambled Sobol sequence integrate the
 // light's smooth part far better than N independent ones: with Sobol points
-// the light's own share of the error of area sampling was 0.09-0.20 of its
+// the light's own share of the error of area sampling is 0.09-0.20 of its
 // independent-sample share with direct light of a large rectangle in a box,
 // 0.25-0.34 over a floor at one light size from the light
 // (bench/light_noise_share.sh). Measured at a fixed receiver point the
@@ -38,28 +37,27 @@
 //
 // The light's own noise with its cheapest strategy is a share s of V: the
 // pilot's light_variance over V, or the rule's model of it at the pilot's
-// receivers (auto_sampler::noise_share), the larger (each alone
-// varied 0.1-1.7 and 0.5-7 between seeds over a floor at 0.3 light sizes,
-// area sampling's noise near a light being heavy-tailed; taking the larger
-// errs towards the choice), at most the share of V's reflected part,
-// 1 - V_E / V: V_E, V's emission term (what camera rays meet first, at
-// its size with the image's samples: noise_pilot_result::edge_variance),
-// holds none of a light sample's noise. The image's samples leave kappa of
-// it: the image's noise is V (1 - (1 - kappa) s), and the choice gains
-// kappa of what the rule models. Near s = 1 V_l is steep in s (dV_l / ds =
-// -V (1 - kappa) / kappa, -6 V at kappa = 0.14), and at s = 1 kappa
-// cancels (V_l = V): capped at 1 instead, s took V_l to V on a box under a
-// disk light covering most of its ceiling with direct light
-// (size_disk_x8, 8 and 32 spp), where V_E is 9-22 % of V and the choice
-// then lost to area sampling everywhere (0.83x); with the cap (s =
-// 0.78-0.87 where it set s) V_l is 1.8-6.8 V there. The rule of the light then sees
-// V_l = V (1 - (1 - kappa) s) / kappa (auto_params::image_variance): its
+// receivers (auto_sampler::noise_share), the larger (each alone varies 0.1-1.7
+// and 0.5-7 between seeds over a floor at 0.3 light sizes, area sampling's
+// noise near a light being heavy-tailed; taking the larger errs towards the
+// choice), at most the share of V's reflected part, 1 - V_E / V: V_E, V's
+// emission term (what camera rays meet first, at its size with the image's
+// samples: noise_pilot_result::edge_variance), holds none of a light sample's
+// noise. The image's samples leave kappa of it: the image's noise is
+// V (1 - (1 - kappa) s), and the choice gains kappa of what the rule models.
+// Near s = 1 V_l is steep in s (dV_l / ds = -V (1 - kappa) / kappa, -6 V at
+// kappa = 0.14), and at s = 1 kappa cancels (V_l = V). Capped at 1 only, s
+// would take V_l to V on a box under a disk light covering most of its ceiling
+// with direct light (size_disk_x8, 8 and 32 spp), where V_E is 9-22 % of V, and
+// the choice would lose to area sampling everywhere (0.83x); with the cap (s =
+// 0.78-0.87 where it sets s) V_l is 1.8-6.8 V there. The rule of the light then
+// sees V_l = V (1 - (1 - kappa) s) / kappa (auto_params::image_variance): its
 // scores v_s / v_rest = kappa D^2 v_s / (V (1 - (1 - kappa) s)) are the
-// modelled gains with the image's samples against the image's noise with
-// them. V <= V_l <= V / kappa: V where the light's noise is all of the
-// image's, V / kappa where it is none of it. The path's noise beyond the
-// light's is left at its independent size: an overestimate, so the choice
-// is weighed against more noise than the image has, never less.
+// modelled gains with the image's samples against the image's noise with them.
+// V <= V_l <= V / kappa: V where the light's noise is all of the image's,
+// V / kappa where it is none of it. The path's noise beyond the light's is left
+// at its independent size: an overestimate, so the choice is weighed against
+// more noise than the image has, never less.
 //
 // The pixels' light samples are the first bounce's; with global light a
 // light sample at a deeper bounce sits on dimensions the sequence
@@ -67,8 +65,8 @@
 // with global light), so the kappa the rule takes is f kappa_1 + (1 - f),
 // kappa_1 measured on the first bounce and f the share of the pilot's light
 // samples taken there (noise_pilot_result::first_bounce_share; 1 with
-// direct light alone). With kappa_1 alone for every light sample the
-// strip light of the mixed scene (cornell_two_lights, global light) got
+// direct light alone). With kappa_1 for every light sample the strip
+// light of the mixed scene (cornell_two_lights, global light) would get
 // V_l = 6 V and area sampling, 0.36x the best fixed strategy.
 #include <algorithm>
 #include <chrono>

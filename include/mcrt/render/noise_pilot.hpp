@@ -20,40 +20,39 @@
 // see (the channels' mean): the light's contribution to a pixel is the
 // surface's albedo times a white surface's, which `auto` takes on average.
 //
-// The emitters the camera sees. Where a pixel straddles the edge of an
-// emitter (or of the background) in view, the radiance the camera ray meets
-// first jumps, and with two samples that pixel's sample variance is either
-// 0 or large: a few such pixels made the pilot's V swing by 6-20x between
-// seeds (the Cornell boxes' ceiling lights). So a sample X is split into E,
-// the radiance the camera ray meets first (emission, or background), and
-// R = X - E, what the surface there reflects: V is the mean of s2(R) (the
-// two samples') over the pilot's blocks plus the mean of s2_K(E), the
-// sample variance of E over K more camera rays (hit tests only) uniform in
-// the pixel. The pixels on an emitter's edge are few (a line of them) and
-// carry most of the image's variance where the camera sees a light (with
-// a fixed grid of every stride-th pixel, V differed 1000-fold between the
-// 400- and the 1024-pixel pilots of the Cornell box with the seed's
-// light). So the mean of s2_K(E) is taken over two strata: the emitters'
-// footprint in the image (emitter_footprint: where a camera ray may meet a
-// listed light), every pixel of it measured with 2 to K rays (a
-// systematic sample of it where it is large), and the rest of the image on
-// blocks of half the side (rounded up), one random pixel each, where only
-// an emitting background or an emitter the lights do not list can add
-// anything (else it is not measured). From random pixels of the finer
-// blocks alone (before commit 79f8d0d) the pilot met 0 to 5 edge pixels of
-// a ceiling light in view and V varied 6000-fold between seeds
-// (size_rect_1of4, direct, 100 x 100, 8 and 32 spp: 0.00016 to 1.08);
-// with the footprint it meets 8 to 11 of them, and V is 0.48 to 0.80.
-// Both terms are unbiased and
-// never negative; their sum falls short of the variance of X by the mean
-// of 2 cov(E, R) over a pixel, small where E and R do not vary together (a
-// light's edge: where a ray meets the emitter it reflects nothing). The
-// unbiased s2(X) - s2(E) + s2_K(E) of each pixel keeps that cross term,
-// which at an edge pixel with two samples is +-|E1 - E2| |R1 - R2|, the
-// light's radiance times the reflected one, offset only by the same
-// pixel's s2_K(E): with s2_K(E) measured on other pixels (commit 8c914c8)
-// the mean fell below 0 (V = 0 at 2 of 8 pilots of a box with a disk
-// light, size_disk_1of4, global).
+// The emitters the camera sees. Where a pixel straddles the edge of an emitter
+// (or of the background) in view, the radiance the camera ray meets first
+// jumps, and with two samples that pixel's sample variance is either 0 or
+// large: from two samples alone a few such pixels make the pilot's V swing by
+// 6-25x between seeds (the Cornell boxes' ceiling lights: size_rect_x4 and
+// size_disk_x4, direct light). So a sample X is split into E, the radiance the
+// camera ray meets first (emission, or background), and R = X - E, what the
+// surface there reflects: V is the mean of s2(R) (the two samples') over the
+// pilot's blocks plus the mean of s2_K(E), the sample variance of E over K more
+// camera rays (hit tests only) uniform in the pixel. The pixels on an emitter's
+// edge are few (a line of them) and carry most of the image's variance where
+// the camera sees a light (a fixed grid of every stride-th pixel meets them or
+// misses them by where its lines fall: its V is 1000-fold apart between the
+// 400- and the 1024-pixel pilots of the Cornell box with the seed's light). So
+// the mean of s2_K(E) is taken over two strata: the emitters' footprint in the
+// image (emitter_footprint: where a camera ray may meet a listed light), every
+// pixel of it measured with 2 to K rays (a systematic sample of it where it is
+// large), and the rest of the image on blocks of half the side (rounded up),
+// one random pixel each, where only an emitting background or an emitter the
+// lights do not list can add anything (else it is not measured). From random
+// pixels of the finer blocks alone the pilot would meet 0 to 5 edge pixels of a
+// small ceiling light in view, and V would vary 6000-fold between seeds
+// (size_rect_1of4, direct, 100 x 100, 8 and 32 spp: 0.00016 to 1.08); with the
+// footprint it meets 8 to 11 of them, and V is 0.48 to 0.80. Both terms are
+// unbiased and never negative; their sum falls short of the variance of X by
+// the mean of 2 cov(E, R) over a pixel, small where E and R do not vary
+// together (a light's edge: where a ray meets the emitter it reflects nothing).
+// The unbiased s2(X) - s2(E) + s2_K(E) of each pixel would keep that cross
+// term, but at an edge pixel with two samples it is +-|E1 - E2| |R1 - R2|, the
+// light's radiance times the reflected one, offset only by the same pixel's
+// s2_K(E): with s2_K(E) measured on other pixels its mean falls below 0 (V = 0
+// at 2 of 8 pilots of a box with a disk light, size_disk_1of4, global), so it
+// is not used.
 //
 // The diffuse surfaces the pixels' centres see are kept too (in pixel
 // order, whichever thread met them), as the receivers at which `auto`
@@ -123,11 +122,12 @@ struct ray_counting_scene {
 // of the image's samples (its two paths, two samples of each light at its
 // first point, its centre's ray and its emission rays: 0.73 us of one
 // thread against 0.11 us per image sample, size_rect_x4, direct light), so
-// that the pilot takes 1-2 % of the image's time on one thread. (With 1 %
-// of the image's samples, before commit a4ddd74, it took 6 % of a 100 x 100
-// image at 8 spp, and `auto` 0.94x the best fixed strategy where that was
-// area sampling everywhere, against 0.98x with 0.25 %: A/B, direct light,
-// 8 and 32 spp x 4 seeds.)
+// that the pilot takes 1-2 % of the image's time on one thread. The budget
+// is small because where one fixed strategy is best everywhere `auto` can
+// at most match it and still pays its pilot: 1 % of the samples would take
+// 6 % of a 100 x 100 render's time at 8 spp, and there `auto` reaches 0.94x
+// the best fixed strategy (area sampling everywhere) with 1 % against
+// 0.98x with 0.25 % (A/B, direct light, 8 and 32 spp x 4 seeds).
 inline noise_pilot_settings noise_pilot_for(int width, int height, int spp) {
   const double budget = 0.0025 * static_cast<double>(width) * height * spp / 2.0;  // pixels at 2 samples
   return {static_cast<int>(std::clamp(budget, 64.0, 1024.0)), 2, 8};
@@ -572,23 +572,6 @@ inline void scale_emission_term(noise_pilot_result& r, double kappa_e) {
   r.edge_variance *= kappa_e;
 }
 
-// What the image's sample generator leaves of the emission term: kappa_E
-// = sum_x w_x N Var_m(mean of E over N camera rays) / sum_x w_x Var(E of
-// one ray), over the pilot's edge pixels x (at most `pixels` of them,
-// evenly spaced in its list), each with M independent scramblings of the
-// image's own samples at its spp (the pixel dimensions, samplers/
-// layout.hpp), Var(E of one ray) the sample variance of all M N rays.
-// An edge crossing a pixel is a discontinuity in the pixel's two
-// dimensions, which stratified and Sobol points resolve better than
-// independent ones: with N of them the variance of a pixel's mean falls
-// about as N^-1.5, not N^-1 (Owen 1997; Pharr et al. 2019, "Efficient
-// generation of points that satisfy two-dimensional elementary
-// intervals", for the pixel's edges); the pilot's s2_K(E) (independent
-// rays) times kappa_E is the emission term's share of the image's noise
-// with the image's samples. A ratio at the pixels where E varied, applied
-// to s2_K(E), which stays unbiased over all pixels (a pixel whose K rays
-// all met the same radiance adds nothing to either). Hit tests only.
-// 1 for independent samples, and where no edge pixel was found.
 // What a sample generator leaves of the noise of a per-sample value at the
 // given pixels: sum_x w_x N Var_m(mean of the value over N samples) /
 // sum_x w_x Var(the value of one sample), with M independent scramblings of
@@ -651,8 +634,25 @@ inline std::vector<edge_pixel> evenly_spaced(std::span<const edge_pixel> pixels,
   return chosen;
 }
 
-// kappa_E (above) with samples of type Sampler: the value is E, what the
-// camera ray meets first (hit tests only).
+// What the image's sample generator leaves of the emission term: kappa_E
+// = sum_x w_x N Var_m(mean of E over N camera rays) / sum_x w_x Var(E of
+// one ray), over the pilot's edge pixels x (at most `pixels` of them,
+// evenly spaced in its list), each with M independent scramblings of the
+// image's own samples at its spp (the pixel dimensions, samplers/
+// layout.hpp), Var(E of one ray) the sample variance of all M N rays.
+// An edge crossing a pixel is a discontinuity in the pixel's two
+// dimensions, which stratified and Sobol points resolve better than
+// independent ones: with N of them the variance of a pixel's mean falls
+// about as N^-1.5, not N^-1 (Owen 1997; Pharr et al. 2019, "Efficient
+// generation of points that satisfy two-dimensional elementary
+// intervals", for the pixel's edges); the pilot's s2_K(E) (independent
+// rays) times kappa_E is the emission term's share of the image's noise
+// with the image's samples. A ratio at the pixels where E varied, applied
+// to s2_K(E), which stays unbiased over all pixels (a pixel whose K rays
+// all met the same radiance adds nothing to either). Hit tests only.
+// 1 for independent samples, and where no edge pixel was found.
+// Here with samples of type Sampler (sequence_noise_factor above): the
+// value is E, what the camera ray meets first (hit tests only).
 template <class Sampler, class Scene>
 double edge_noise_factor_with(const Scene& sc, const camera& cam, const render_settings& rs,
                               std::span<const edge_pixel> edges, int scramblings = 2, int pixels = 512) {

@@ -33,8 +33,8 @@ struct render_settings {
   int rr_depth = 1;  // see path_settings
   std::uint64_t seed = 0;
   unsigned threads = 0;  // 0: all hardware threads
-  integrator_kind integrator = integrator_kind::mixture;
-  sampler_kind sampler = sampler_kind::sobol;  // the most efficient in the study (README)
+  integrator_kind integrator = integrator_kind::mis;  // as pbrt-v4's and Mitsuba 3's path tracers
+  sampler_kind sampler = sampler_kind::sobol;  // the most efficient in the study (docs/results.md)
   light_choice choose = light_choice::power;       // nee, mis (path_settings)
   mis_heuristic heuristic = mis_heuristic::power;  // mis (path_settings)
 

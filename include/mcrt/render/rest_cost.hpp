@@ -25,10 +25,11 @@
 // light, nee, this machine (bench/rest_cost.py, which prints the fit and
 // the residuals of these constants: 10 % rms, at most 25-29 %, the
 // distance family, a large floor with few primitives, measured up to 25 %
-// cheaper than modelled). Measured in each run instead, the time varied by
-// up to 2x between runs of the same command (a 100 x 100 pilot takes a few
-// ms), and with it which pixels kappa was measured at, kappa and some
-// choices.
+// cheaper than modelled). A time measured in each run varies by up to 2x
+// between runs of the same command (a 100 x 100 pilot takes a few ms:
+// distance_h1, direct light, 78-149 ns per light sample), and with it
+// which pixels kappa would be measured at, kappa and some choices: the
+// same command would give different images. Modelled, they do not.
 #include <algorithm>
 #include <cstddef>
 #include <tuple>

@@ -17,8 +17,9 @@
 // smallest product is taken (efficiency = 1 / (error x time)); where v_rest
 // comes from the image's measured noise (auto_params), the first-order form
 // of the image's own product, cost_s / t + v_s / v_rest. v_s from the
-// geometry at four points of the light, a rule exact for cubic (rectangle)
-// or quadratic (disk) variation over the light's surface:
+// geometry at a few points of the light (planar_rule: a delta-method test
+// at the centre, a 4-point rule, then a 9-point (rectangle) or 12-point
+// (disk) rule; auto_model for a sphere: 8 points of its visible cap):
 //  * area: the estimate is L A g, g = cos+(theta) cos(theta_l) / r^2, so
 //    v_area = E_A[g^2] / E_A[g]^2 - 1 (uniform on the surface);
 //  * solid angle: the estimate is L Omega cos+(theta), so v_sa = E_w[c^2] /
@@ -29,28 +30,30 @@
 // v_area and v_sa (their samples there are wasted), not v_psa.
 //
 // The constants (struct auto_costs) are measurements: the strategies'
-// costs from the README's cost tables (sample + pdf) or, for nee, which
+// costs from the sampler benchmarks (sample + pdf) or, for nee, which
 // takes a light sample's pdf with it, inside renders
-// (bench/strategy_costs.py), c_rest from the error-against-time
-// study (cornell_rect, nee, sobol: ms per spp of area and solid-angle
-// sampling, 318 and 451 ns per path at 1.13 light samples per path, leave
-// 265 ns per light sample for the rest); a fixed v_rest = 4 is the value,
-// of those tried (0.25, 1, 4, 16), with the best worst case over the seed's
-// scenes, and `mcrt render` measures the image's noise instead (README,
-// "Choosing per shading point", which also says how far this rule is from
-// the best fixed strategy).
+// (bench/strategy_costs.py); the default c_rest, where `mcrt render` does
+// not model it from its pilot (render/rest_cost.hpp), from the
+// error-against-time study (cornell_rect, nee, sobol: ms per spp of area
+// and solid-angle sampling, 318 and 451 ns per path at 1.13 light samples
+// per path, leave 265 ns per light sample for the rest); a fixed v_rest =
+// 4 is the value, of those tried (0.25, 1, 4, 16), with the best worst case
+// over the seed's scenes, and `mcrt render` measures the image's noise
+// instead (docs/auto.md, which also says how far this rule is from the
+// best fixed strategy).
 //
 // Where a receiver is close to a planar light (nearer to it than the
 // rule's points are to each other) g peaks near the light's nearest point
-// and no fixed quadrature sees the peak; the model then takes the peak's
-// own variance (see auto_choice::v_area), and the light's exact projected
-// solid angle (Lambert's) instead of the rule's mean of g, which its middle
-// point on the peak makes many times too large (5x, 20x, 126x at 0.1, 0.05,
-// 0.02 of a rectangle's size below its middle). auto_sampler evaluates the rule
-// of a light once per cell of a table of receiver positions and normals
-// (auto_table.hpp; for a sphere, of distances and normals' angles to its
-// centre), so a shading point pays a lookup, not the rule (and each cell
-// the rule once, when a receiver first falls in it); and where even that
+// and no fixed quadrature sees the peak; the model then integrates v_area
+// about the peak (planar_rule::peak_v_area; auto_choice::v_area), and takes
+// the light's exact projected solid angle (Lambert's) instead of the rule's
+// mean of g, which its middle point on the peak makes many times too large
+// (5x, 20x, 126x at 0.1, 0.05, 0.02 of a rectangle's size below its
+// middle). auto_sampler evaluates the rule of a light once per cell of a
+// table of receiver positions and normals (auto_table.hpp; for a sphere,
+// of distances and normals' angles to its centre), so a shading point
+// pays a lookup, not the rule (and each cell the rule once, when a
+// receiver first falls in it); and where even that
 // does not pay at the surfaces the image sees, the light takes its
 // cheapest strategy everywhere (auto_sampler::table_gain).
 #include <algorithm>
@@ -233,8 +236,8 @@ class auto_choice {
   // normal lies in the light's plane, and beside the light (farther from
   // its edge than from its plane) 5 q / 24 facing it, 5 q / 32 with the
   // normal in the plane; on the walls under a large ceiling light the
-  // bound was 1.6-1.8 times the true v_area (tests/test_auto_strategy.cpp,
-  // PeakVarianceIntegrated).
+  // bound is 1.6-1.8 times the true v_area (tests/test_auto_strategy.cpp,
+  // PeakVarianceIntegrated), which is why the fine rule integrates instead.
   float v_area() const {
     if (!(sg_ > 0.0f)) return 0.0f;
     if (peaked() && v_peak_ >= 0.0f) return v_peak_;
