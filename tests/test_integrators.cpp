@@ -7,7 +7,11 @@
 // generator gives the same mean image.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <string>
 #include <vector>
@@ -289,6 +293,30 @@ TEST(Integrators, AgreeInMeanWithCosineAwareStrategies) {
     expect_scene_agrees(name, light_sampling::projected_solid_angle);
   for (const char* name : {"cornell_rect", "cornell_disk_large"})
     expect_scene_agrees(name, light_sampling::bilinear_solid_angle);
+}
+
+// The scene loader keeps a `rect` turned in a coordinate plane as a general
+// rectangle (only one whose edges lie along the axes joins the axis-aligned
+// set), and its self-intersection guard is 2e-6 of the largest coordinate any
+// shape reaches: here the turned rectangle's corner + edge1 (x = 900), which
+// neither its corner nor corner + edge1 + edge2 reaches, beyond a sphere whose
+// reach (z = 700) lies beyond its centre.
+TEST(SceneLoader, TurnedRectanglesStayGeneralAndTheGuardCountsEveryCorner) {
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / ("mcrt_loader_" + std::to_string(::getpid()) + ".json");
+  std::ofstream(file) << R"({
+  "camera": {"lookfrom": [0, 1, -3], "lookat": [0, 0.5, 0], "vfov": 40, "width": 8, "height": 8},
+  "materials": {"white": {"type": "lambertian", "albedo": [0.5, 0.5, 0.5]},
+                "lamp": {"type": "diffuse_light", "emit": [4, 4, 4]}},
+  "objects": [
+    {"type": "rect", "corner": [0, 2, 0], "edge1": [900, 0, -500], "edge2": [-50, 0, -90], "material": "lamp"},
+    {"type": "rect", "corner": [0, 0, 0], "edge1": [0, 0, 3], "edge2": [2, 0, 0], "material": "white"},
+    {"type": "sphere", "center": [0, 0, 600], "radius": 100, "material": "white"}]})";
+  const cli::loaded_scene ls = cli::load_scene(file.string());
+  std::filesystem::remove(file);
+  EXPECT_EQ(ls.world.axis_rects.size(), 1u) << "only the rectangle with edges along the axes is axis-aligned";
+  EXPECT_EQ(std::get<std::vector<object<rect>>>(ls.world.objects).size(), 1u);
+  EXPECT_FLOAT_EQ(ls.world.ray_epsilon, 2e-6f * 900.0f);
 }
 
 // `auto` (a strategy chosen per light and shading point) on a rectangle, a
