@@ -1,7 +1,7 @@
 // Cost of solid-angle sampling of ellipses: sample plus pdf per call,
 // observers spread around the light (bench/observers.hpp), the same loop as
 // BM_SampleEllipseArea. The two solvers of the parallel map's area equation
-// side by side (Newton on the Carlson closed form, and the seed's 10-step
+// side by side (Newton on the Carlson closed form, and the thesis's 10-step
 // bisection on a 10-interval Simpson rule), and the polar map.
 #include <benchmark/benchmark.h>
 

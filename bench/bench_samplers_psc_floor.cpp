@@ -1,3 +1,25 @@
+// Derived from PSCMaps.h of C. Urena and I. Georgiev (Apache License 2.0;
+// THIRD_PARTY.md has the licence's text and lists the changes). Its notice:
+//
+// *********************************************************************
+// **
+// ** Projected Spherical Cap Maps
+// ** template class 'PSCMaps' (class and aux funcs declaration)
+// **
+// ** Copyright (C) 2018 Carlos Ureña and Iliyan Georgiev
+// **
+// ** Licensed under the Apache License, Version 2.0 (the "License");
+// ** you may not use this file except in compliance with the License.
+// ** You may obtain a copy of the License at
+// **
+// **    http://www.apache.org/licenses/LICENSE-2.0
+// **
+// ** Unless required by applicable law or agreed to in writing, software
+// ** distributed under the License is distributed on an "AS IS" BASIS,
+// ** WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+// ** See the License for the specific language governing permissions and
+// ** limitations under the License.
+
 // Cost floor of projected-solid-angle sphere sampling: the sampler of Urena
 // & Georgiev 2018, "Stratified Sampling of Projected Spherical Caps" (EGSR
 // 2018, CGF 37(4)), below [UG18], as its authors published it

@@ -4,7 +4,7 @@
 Renders each scene with `--light-sampling auto` (nee, Sobol, 8 spp) REPS
 times, direct and global light, and reads from the stats the pilot's
 measured time per light sample and its counted rays and paths per
-light sample. The scenes: the seed's Cornell scenes, the study's size and
+light sample. The scenes: the thesis's Cornell scenes, the study's size and
 distance families (100 x 100), and four of them with 12 further primitives
 of each type out of view (150 x 150), so that each type's test cost is seen
 apart. The fastest run's time, less the light's cheapest strategy's

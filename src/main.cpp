@@ -287,7 +287,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"parallel", "polar"}));
   render_cmd->add_option("--integrator", ro.integrator,
                          "Estimator: mis (next-event estimation with multiple importance sampling, default), nee "
-                         "(next-event estimation) or mixture (Shirley's mixture pdf, the seed's estimator)")
+                         "(next-event estimation) or mixture (Shirley's mixture pdf)")
       ->check(CLI::IsMember({"mixture", "nee", "mis"}));
   render_cmd->add_option("--sampler", ro.sampler, "Sample generator: independent, stratified or sobol (default: sobol)")
       ->check(CLI::IsMember({"independent", "stratified", "sobol"}));

@@ -206,7 +206,7 @@ std::pair<float, float> interval(const reader& rd, const json& o, const std::str
 // book 3's glass sphere) with its strategy: the geometry and the light.
 // `strategy` is nullopt where neither the scene nor the command line names
 // one: rectangles and ellipses are then sampled by area, spheres by their
-// cone of directions (solid angle), as the seed's scenes were. A shape
+// cone of directions (solid angle), as the thesis's scenes were. A shape
 // without the named strategy keeps the closest one it has: a sphere asked
 // for bilinear-solid-angle (a pre-warp of a planar light's map) gets its
 // exact projected-solid-angle map, which that pre-warp approximates.

@@ -433,24 +433,17 @@ TEST(Chi2Harness, SignificanceIsSidakCorrected) {
 
 TEST(Chi2Harness, SurvivalFunction) {
   // dof = 2: Q(1, x/2) = exp(-x/2) exactly.
-  for (const double x : {0.1, 1.0, 10.0, 50.0}) {
-    EXPECT_NEAR(test::chi2_survival(x, 2), std::exp(-0.5 * x), 1e-14);
-    EXPECT_NEAR(test::detail::gamma_q_series_cf(1.0, 0.5 * x), std::exp(-0.5 * x), 1e-14);
-  }
+  for (const double x : {0.1, 1.0, 10.0, 50.0}) EXPECT_NEAR(test::chi2_survival(x, 2), std::exp(-0.5 * x), 1e-14);
   // dof = 1: Q(1/2, x/2) = erfc(sqrt(x/2)).
-  for (const double x : {0.01, 1.0, 9.0, 30.0}) {
-    EXPECT_NEAR(test::detail::gamma_q_series_cf(0.5, 0.5 * x), std::erfc(std::sqrt(0.5 * x)),
-                1e-13 * std::erfc(std::sqrt(0.5 * x)) + 1e-15);
-  }
+  for (const double x : {0.01, 1.0, 9.0, 30.0})
+    EXPECT_NEAR(test::chi2_survival(x, 1), std::erfc(std::sqrt(0.5 * x)), 1e-13 * std::erfc(std::sqrt(0.5 * x)) + 1e-15);
   // Many degrees of freedom, as in the tests: the median of chi2(k) is about
-  // k (1 - 2/(9k))^3 (Wilson & Hilferty 1931), and the two implementations agree.
+  // k (1 - 2/(9k))^3 (Wilson & Hilferty 1931), and Q falls as x grows.
   for (const int k : {100, 5000, 20000}) {
     const double median = k * std::pow(1.0 - 2.0 / (9.0 * k), 3.0);
     EXPECT_NEAR(test::chi2_survival(median, k), 0.5, 2e-3);
-    for (const double x : {0.8 * k, 1.0 * k, 1.2 * k}) {
-      const double q = test::chi2_survival(x, k);
-      EXPECT_NEAR(test::detail::gamma_q_series_cf(0.5 * k, 0.5 * x), q, 1e-10 * q + 1e-300);
-    }
+    EXPECT_GT(test::chi2_survival(0.8 * k, k), test::chi2_survival(1.0 * k, k));
+    EXPECT_GT(test::chi2_survival(1.0 * k, k), test::chi2_survival(1.2 * k, k));
   }
 }
 

@@ -15,9 +15,16 @@ markdown tables, plots and a report.
 Usage (from the repository root, with the virtual environment made by
 scripts/setup.sh)::
 
-    .venv/bin/python scripts/study.py                 # full study -> bench/results/
+    .venv/bin/python scripts/study.py                 # full study -> study-out/<UTC time>/
     .venv/bin/python scripts/study.py --quick         # a few minutes -> build/study-quick/
     .venv/bin/python scripts/study.py --quick --check # and verify the outputs
+    .venv/bin/python scripts/study.py --out bench/results --overwrite-committed
+                                                      # rewrite the committed report
+
+    # your own scene file (a path; a name without .json is looked up in scenes/)
+    .venv/bin/python scripts/study.py --scenes path/to/my_scene.json \
+        --integrators nee --samplers sobol \
+        --strategies area solid-angle projected-solid-angle auto
 
     # choose what to run: every axis has its option
     .venv/bin/python scripts/study.py --scenes cornell_rect cornell_disk \\
@@ -41,6 +48,17 @@ references ~20 min, mcrt process start-up and image I/O ~10 min).
 ``--quick``: 48x48, spp 4, 8, 16, 32, one seed, integrators mixture and mis,
 samplers independent and sobol, both depth modes, 1024 spp references, output
 in build/study-quick (ignored by git); each of these can still be overridden.
+
+Where a run writes. Without ``--out`` every run writes to a new directory,
+study-out/<UTC start time>/ under the current directory (study-out/ holds a
+.gitignore of '*', so git ignores it wherever it lies); the log's first line
+names it, and ``--out`` naming it resumes that run or rebuilds its report
+(``--report-only`` needs ``--out``). A directory that holds files tracked by
+git (the committed results: bench/results/, bench/results/strategy_map/, ...)
+is rewritten only with ``--overwrite-committed``; without it the command
+writes nothing, prints one line and exits with status 2. The report links only
+the figures git keeps beside it (where git would ignore a figure but keep the
+report, the figure is written and named, not linked).
 
 Generated scene families. ``--scenes`` also takes the name of a generated
 family, meaning all its members, or of one member: size_rect, size_disk,
@@ -73,7 +91,7 @@ key of the earlier, single-integrator study, whose cache stays valid.
 Resuming. Every finished point is written at once as its own file,
 OUT/points/<hash>.json (by whichever process rendered it, through a temporary
 name and a rename, so never half-written), and appended to OUT/results.csv;
-a run, and --report-only, first merge into the CSV the point files it lacks
+a run with the same --out, and --report-only, first merge into the CSV the point files it lacks
 (those made with the settings study_state.json records), so a crashed or
 killed run loses no finished point. A run skips the points already there (a point is scene, strategy, integrator,
 sampler, max depth, spp, seed). OUT/study_state.json remembers, per scene and
@@ -136,8 +154,9 @@ Outputs (in OUT):
                          (278, 278, 279.5), or for the distance family from the
                          floor point under the light, empty when not computed)
     tables.md            the markdown tables
-    README.md            the report: machine, commit, command line, date,
-                         tables, sampler costs and the plots
+    README.md            the report: machine, the renderer's commit and the
+                         mcrt binary's sha256, command line, date, tables,
+                         sampler costs and the plots
     efficiency_global.png, efficiency_direct.png  (efficiency per configuration
                          and scene, grouped bars, log scale)
     rmse_vs_spp.png, time_vs_spp.png, rmse_vs_time.png, efficiency.png,
@@ -168,13 +187,17 @@ cli.main):
                     merging point files into results.csv
     analysis.py     efficiency, standard errors, equal-time interpolation,
                     convergence slopes, crossovers (pure; no files)
-    report.py       markdown tables and README.md
+    report.py       markdown tables and README.md (the renderer's commit, the
+                    machine, links only to figures git keeps)
     plots.py        the figures (matplotlib)
     check.py        --check
     cli.py          main()
     util.py         hashes, atomic writes, logging, the progress bar
+    summary_figure.py  docs/images/summary.png from the committed results
+                    (cd scripts && ../.venv/bin/python -m mcrt_study.summary_figure)
     tests/          unit tests of the analysis on synthetic data, of the cache
-                    keys, of the scene families and of the sweep on its
-                    executors with point files (a fake render, no mcrt):
+                    keys, of the scene families, of the sweep on its
+                    executors with point files (a fake render, no mcrt), of
+                    where a run writes and of the report's provenance and links:
                     .venv/bin/python -m unittest discover -s scripts/mcrt_study/tests -t scripts
 """

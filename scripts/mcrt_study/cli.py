@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import datetime
+import shlex
 import signal
 import sys
 import time
@@ -11,7 +12,7 @@ from .analysis import scene_panels, select_rows, slice_rows
 from .check import run_checks
 from .config import (
     Config, Failure, REPORT_MD, RESULTS_CSV, STATE_JSON, SceneInfo, Settings, build_parser,
-    resolve_settings,
+    make_new_output_dir, output_refusal, resolve_settings,
 )
 from .executors import add_arguments, backend_of
 from .plots import make_efficiency_plots, make_slice_plots
@@ -54,18 +55,35 @@ def report_only_inputs(settings: Settings, scenes: list[SceneInfo], spp_given: b
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the study (or rebuild its report); 0 on success, 1 on failure."""
+    """Run the study (or rebuild its report); 0 on success, 1 on failure, 2 when the output
+    directory is refused (one line on stderr: see config.output_refusal)."""
     argv = sys.argv if argv is None else argv
-    # Stop cleanly (temporary images removed, finished points kept) on SIGTERM too.
-    signal.signal(signal.SIGTERM, lambda *_: (_ for _ in ()).throw(KeyboardInterrupt()))
     parser = build_parser()
     add_arguments(parser)
     args = parser.parse_args(argv[1:])
     settings = resolve_settings(args, argv)
+    refusal = output_refusal(args, settings)
+    if refusal:
+        print(f"study.py: {refusal}", file=sys.stderr)
+        return 2
+    # Stop cleanly (temporary images removed, finished points kept) on SIGTERM too.
+    signal.signal(signal.SIGTERM, lambda *_: (_ for _ in ()).throw(KeyboardInterrupt()))
+    try:
+        return study(args, settings)
+    except KeyboardInterrupt as stop:
+        stop.resume_hint = ("run the same command with --out " + shlex.quote(str(settings.out)) + " to resume"
+                            if settings.out_is_new else "run the same command again to resume")
+        raise
+
+
+def study(args, settings: Settings) -> int:
+    """main()'s run once the output directory is settled."""
     backend = backend_of(args)
     started = datetime.datetime.now(datetime.timezone.utc)
     t0 = time.monotonic()
-    log(f"output: {settings.out}")
+    if settings.out_is_new:
+        make_new_output_dir(settings.out)
+    log(f"output: {settings.out}" + (" (a new directory; --out DIR chooses one)" if settings.out_is_new else ""))
     scenes = load_scenes(settings.scenes, settings)
     if settings.report_only:
         rows = report_only_inputs(settings, scenes, args.spp is not None, args.seeds is not None)
@@ -99,7 +117,7 @@ def run(argv: list[str] | None = None) -> int:
     """main() as a command's exit status: 130, with a note, when interrupted (Ctrl-C, SIGTERM)."""
     try:
         return main(argv)
-    except KeyboardInterrupt:
-        print("\nstudy: interrupted; the points finished so far are in the CSV, "
-              "run the same command again to resume", file=sys.stderr)
+    except KeyboardInterrupt as stop:
+        hint = getattr(stop, "resume_hint", "run the same command again to resume")
+        print(f"\nstudy: interrupted; the points finished so far are in the CSV, {hint}", file=sys.stderr)
         return 130

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import datetime
 import itertools
 import os
 import shlex
+import subprocess
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -45,7 +47,11 @@ DEFAULT_REF_SPP = 4096
 DEFAULT_REF_SEED = 7919
 DEFAULT_REF_INTEGRATOR = "mis"
 DEFAULT_REF_SAMPLER = "sobol"
-DEFAULT_OUT = REPO_ROOT / "bench" / "results"
+# Without --out a run writes to a new directory, study-out/<UTC start time>/ under the current
+# directory (not tracked by git); the committed results (bench/results/...) are rewritten only
+# with --out naming them and --overwrite-committed.
+NEW_OUT_PARENT = Path("study-out")
+COMMITTED_RESULTS = REPO_ROOT / "bench" / "results"
 
 QUICK_SPP = [4, 8, 16, 32]
 QUICK_SEEDS = [1]
@@ -224,6 +230,8 @@ class Settings:
     # Runs of each render whose median time is its time (renders of a few
     # ms vary by 10-20 % run to run; the image is the same every run).
     time_repeats: int = 1
+    # True when `out` is the new directory chosen without --out (resuming needs --out naming it).
+    out_is_new: bool = False
 
     @property
     def configs(self) -> list[Config]:
@@ -277,7 +285,12 @@ def build_parser() -> argparse.ArgumentParser:
                    "skipped if missing)")
     p.add_argument("--no-bench", action="store_true", help="do not run the sampler benchmark")
     p.add_argument("--out", type=Path, default=None,
-                   help="output directory (default: bench/results, or build/study-quick with --quick)")
+                   help=f"output directory; the same --out again resumes a run (default: a new directory "
+                   f"{NEW_OUT_PARENT}/<UTC time>/ under the current directory, or build/study-quick with --quick)")
+    p.add_argument("--overwrite-committed", action="store_true",
+                   help="allow --out to name a directory that holds files tracked by git (the committed "
+                   "results, e.g. --out bench/results/strategy_map), whose files the run rewrites; "
+                   "without it such a directory is refused (exit status 2)")
     p.add_argument("--scenes", nargs="+", default=None,
                    help="scene names in scenes/, paths to scene files, generated families "
                    "(size_rect, size_disk, size_sphere, distance: all their members) or members "
@@ -357,7 +370,7 @@ def resolve_settings(args: argparse.Namespace, argv: list[str]) -> Settings:
     settings = Settings(
         mcrt=mcrt,
         bench=bench,
-        out=(args.out or (QUICK_OUT if quick else DEFAULT_OUT)).resolve(),
+        out=(args.out or (QUICK_OUT if quick else new_output_dir())).resolve(),
         scenes=args.scenes or list(DEFAULT_SCENES),
         strategies=args.strategies or list(QUICK_STRATEGIES if quick else DEFAULT_STRATEGIES),
         integrators=args.integrators or list(QUICK_INTEGRATORS if quick else INTEGRATORS),
@@ -411,6 +424,7 @@ def resolve_settings(args: argparse.Namespace, argv: list[str]) -> Settings:
     settings.pixel_maps = list(dict.fromkeys(args.pixel_maps or []))
     settings.pixel_map_seeds, settings.pixel_map_spp = args.pixel_map_seeds, args.pixel_map_spp
     settings.time_repeats = args.time_repeats
+    settings.out_is_new = args.out is None and not quick
     if settings.time_repeats < 1:
         problems.append("--time-repeats must be positive")
     if settings.pixel_map_seeds < 1 or (settings.pixel_map_spp is not None and settings.pixel_map_spp < 1):
@@ -418,6 +432,62 @@ def resolve_settings(args: argparse.Namespace, argv: list[str]) -> Settings:
     if problems:
         raise SystemExit("study.py: " + "; ".join(problems))
     return settings
+
+
+def new_output_dir(parent: Path | None = None, now: datetime.datetime | None = None) -> Path:
+    """A directory that does not exist yet for a run without --out: PARENT/<UTC time>
+    (default parent: study-out/ under the current directory), with -2, -3, ... appended when a
+    run of the same second took that name. Not created here."""
+    parent = (parent if parent is not None else NEW_OUT_PARENT).resolve()
+    stamp = (now or datetime.datetime.now(datetime.timezone.utc)).strftime("%Y-%m-%dT%H%M%SZ")
+    path, n = parent / stamp, 2
+    while path.exists():
+        path, n = parent / f"{stamp}-{n}", n + 1
+    return path
+
+
+def make_new_output_dir(out: Path) -> None:
+    """Create the new directory of a run without --out, and beside it in its parent (study-out/)
+    a .gitignore of '*', so that git ignores every run's directory wherever the parent lies."""
+    out.parent.mkdir(parents=True, exist_ok=True)
+    ignore = out.parent / ".gitignore"
+    if not ignore.exists():
+        ignore.write_text("# Outputs of scripts/study.py runs without --out; not tracked.\n*\n", encoding="utf-8")
+    out.mkdir()
+
+
+def committed_files(path: Path) -> list[str]:
+    """The files under `path` that git tracks (paths relative to the repository's top), in the
+    repository that holds `path`; empty when it holds none, lies in no repository or git is
+    missing. Without git, a non-empty directory under bench/results counts as committed."""
+    probe = Path(path).resolve()
+    while not probe.is_dir() and probe != probe.parent:
+        probe = probe.parent
+    try:
+        listed = subprocess.run(["git", "-C", str(probe), "ls-files", "-z", "--", str(Path(path).resolve())],
+                                capture_output=True, text=True)
+    except OSError:  # no git: the committed results are known by where they are
+        inside = Path(path).resolve().is_relative_to(COMMITTED_RESULTS.resolve())
+        return sorted(str(f) for f in Path(path).rglob("*") if f.is_file()) if inside and Path(path).is_dir() else []
+    if listed.returncode != 0:  # not in a repository (or outside this one's work tree)
+        return []
+    return [f for f in listed.stdout.split("\0") if f]
+
+
+def output_refusal(args: argparse.Namespace, settings: Settings) -> str:
+    """Why the run must not write to its output directory ("" when it may): --report-only without
+    --out (nothing to report on in a new directory), or an --out that holds files tracked by git
+    (the committed results) without --overwrite-committed."""
+    if args.report_only and args.out is None and not args.quick:
+        return "--report-only needs --out DIR, the directory of the run to report on"
+    if getattr(args, "overwrite_committed", False):
+        return ""
+    committed = committed_files(settings.out)
+    if committed:
+        files = f"{len(committed)} file{'s' if len(committed) != 1 else ''}"
+        return (f"{repo_relative(str(settings.out))} holds committed results ({files} tracked by git); "
+                "rewrite them with --overwrite-committed, or leave out --out to write to a new directory")
+    return ""
 
 
 def repo_relative(path: str) -> str:

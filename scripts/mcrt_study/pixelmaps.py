@@ -196,14 +196,15 @@ def compute_maps(reference, errors: dict[str, object], seconds: dict[str, float]
 
 
 def map_key(settings: Settings, scene: SceneInfo, mode: str, config_strategies: list[str], spp: int,
-            seeds: list[int], reference_key: str) -> str:
-    """What a map depends on, hashed: its .npz is reused only when this matches."""
+            seeds: list[int], reference_key: str, binary_hash: str = "") -> str:
+    """What a map depends on, hashed: its .npz is reused only when this matches (the renderer's
+    binary included: a map made by another build is made again)."""
     integrator, sampler, _ = slice_of(settings)
     return sha256_json({
         "scene_sha256": scene.content_sha256, "width": scene.width, "height": scene.height,
         "max_depth": scene.depth(mode), "integrator": integrator, "sampler": sampler,
         "strategies": config_strategies, "spp": spp, "seeds": seeds, "reference": reference_key,
-        "filter": FILTER_SIZE,
+        "filter": FILTER_SIZE, "mcrt_sha256": binary_hash,
     })[:16]
 
 
@@ -335,7 +336,7 @@ def make_pixel_map(settings: Settings, scene: SceneInfo, spp: int, seeds: list[i
     if ref is None:
         log(f"pixel map {scene.name}: no cached reference ({mode}); not made")
         return None
-    key = map_key(settings, scene, mode, strategies, spp, seeds, ref.key)
+    key = map_key(settings, scene, mode, strategies, spp, seeds, ref.key, binary_hash)
     stem = f"pixelmap_{scene.name}_{mode}"
     npz = settings.out / f"{stem}.npz"
     pm = load_npz(npz)

@@ -337,6 +337,95 @@ def machine_info(out: Path | None = None) -> dict[str, str]:
             "python": platform.python_version()}
 
 
+# The sources of the renderer (the mcrt executable) and of the sampler benchmark the study runs:
+# a change elsewhere (documentation, scripts, tests, results) leaves the binary as it was.
+RENDERER_SOURCES = ["CMakeLists.txt", "cmake", "include", "src"]
+BENCH_SOURCES = ["bench/CMakeLists.txt", ":(glob)bench/*.cpp", ":(glob)bench/*.hpp", ":(glob)bench/*.inc"]
+
+
+def renderer_commit(out: Path | None = None, sources: list[str] | None = None) -> tuple[str, bool]:
+    """The commit of the renderer the repository builds and whether the work tree changes it: the
+    last commit (up to HEAD) that changed its sources (RENDERER_SOURCES), as a short hash, and True
+    when tracked or new files among those sources differ from it (changes under `out`, the
+    study's own outputs, do not count, nor do changes anywhere else: documentation, scripts,
+    tests, results); ("unknown", False) outside a git repository."""
+    sources = sources or RENDERER_SOURCES
+    exclude = []
+    if out is not None:
+        try:
+            exclude = [":(exclude)" + str(Path(out).resolve().relative_to(REPO_ROOT.resolve()))]
+        except ValueError:  # outside the repository
+            pass
+
+    def git(*args: str) -> str:
+        return subprocess.run(["git", "-C", str(REPO_ROOT), *args], capture_output=True, text=True,
+                              check=True).stdout.strip()
+    try:
+        commit = git("log", "-1", "--format=%h", "HEAD", "--", *sources) or git("rev-parse", "--short", "HEAD")
+        dirty = git("status", "--porcelain", "--untracked-files=all", "--", *sources, *exclude)
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown", False
+    return commit, bool(dirty)
+
+
+def machine_name(cpu: str, cores: str) -> str:
+    """The machine as the reports name it: '2-core KVM virtual machine, CPU AMD EPYC' (lscpu's
+    hypervisor vendor; without one, '8-core machine, CPU ...')."""
+    kind = "machine"
+    try:
+        lscpu = subprocess.run(["lscpu"], capture_output=True, text=True, check=True).stdout
+        for line in lscpu.splitlines():
+            if line.lower().startswith("hypervisor vendor:"):
+                kind = f"{line.split(':', 1)[1].strip()} virtual machine"
+    except (OSError, subprocess.CalledProcessError):
+        try:
+            if " hypervisor" in Path("/proc/cpuinfo").read_text(encoding="utf-8"):
+                kind = "virtual machine"
+        except OSError:
+            pass
+    return f"{cores}-core {kind}, CPU {cpu}"
+
+
+def memory_gib() -> str:
+    """Total memory in GiB ('?' where /proc/meminfo is missing)."""
+    try:
+        for line in Path("/proc/meminfo").read_text(encoding="utf-8").splitlines():
+            if line.startswith("MemTotal:"):
+                return f"{int(line.split()[1]) / 2**20:.0f}"
+    except (OSError, ValueError, IndexError):
+        pass
+    return "?"
+
+
+def unkept_figures(out: Path, names: list[str]) -> list[str]:
+    """The figures among `names` (files in `out`) that git ignores while it keeps the report
+    beside them: the report does not link them, since a committed report would link files that
+    are not committed. Where the report itself is ignored, or `out` lies outside a repository,
+    every figure stays with it and none is returned."""
+    if not names:
+        return []
+    try:
+        found = subprocess.run(["git", "-C", str(out), "check-ignore", "--", REPORT_MD, *names],
+                               capture_output=True, text=True)
+    except OSError:
+        return []
+    if found.returncode not in (0, 1):  # not a repository
+        return []
+    ignored = {Path(line).name for line in found.stdout.splitlines()}
+    if REPORT_MD in ignored:
+        return []
+    return [n for n in names if n in ignored]
+
+
+def drop_figure_links(text: str, names: list[str]) -> str:
+    """`text` without the figure blocks ('![..](NAME)', a blank line and the caption line) of `names`."""
+    import re
+
+    for name in names:
+        text = re.sub(r"\n?!\[[^\]]*\]\(" + re.escape(name) + r"\)\n(\n[^\n]*\n)?", "\n", text)
+    return text
+
+
 def failure_lines(failures: list[Failure]) -> list[str]:
     """The report's lines for skipped or failed configurations, one per scene, strategy and reason."""
     grouped: dict[tuple, list[str]] = {}
@@ -368,8 +457,13 @@ def write_report(settings: Settings, scenes: list[SceneInfo], tables: str,
                  figures: list[tuple[str, str]], started: datetime.datetime) -> None:
     """Write tables.md and the report README.md (relative links to the plots)."""
     out = settings.out
+    # Only the figures that stay beside the report are linked (see unkept_figures).
+    unkept = unkept_figures(out, [name for name, _ in figures])
+    tables = drop_figure_links(tables, unkept)
     write_text_atomic(out / TABLES_MD, tables)
     info = machine_info(out)
+    sources = RENDERER_SOURCES + (BENCH_SOURCES if settings.bench is not None and settings.bench.is_file() else [])
+    renderer, changed = renderer_commit(out, sources)
     state = read_state(out / STATE_JSON)
     mcrt_hash = sha256_file(settings.mcrt)[:12] if settings.mcrt.is_file() else "?"
     threads = str(settings.threads) if settings.threads else f"all ({info['cores']})"
@@ -383,9 +477,10 @@ def write_report(settings: Settings, scenes: list[SceneInfo], tables: str,
         + (" (**--quick**: a smoke test, not a measurement)" if settings.quick else "") + ".\n",
         "## Setup\n",
         f"- Command: `{settings.command_line}`",
-        f"- Commit: `{info['commit']}`",
-        f"- Machine: {info['cpu']}, {info['cores']} cores, {info['os']}; render threads: {threads}",
-        f"- mcrt: `{repo_relative(str(settings.mcrt))}` (sha256 {mcrt_hash}…)",
+        f"- Renderer: commit `{renderer}`" + (" with uncommitted changes to its sources" if changed else "")
+        + f" (mcrt sha256 {mcrt_hash}…, run as `{repo_relative(str(settings.mcrt))}`)",
+        f"- Machine: {machine_name(info['cpu'], info['cores'])}, {memory_gib()} GiB, {info['os']}; "
+        f"render threads: {threads}",
         f"- Scenes: {', '.join(sc.name for sc in scenes)}",
         f"- Configurations ({len(settings.configs)}): integrators {', '.join(settings.integrators)}; "
         f"samplers {', '.join(settings.samplers)}; strategies {', '.join(settings.strategies)}; "
@@ -432,11 +527,14 @@ def write_report(settings: Settings, scenes: list[SceneInfo], tables: str,
     lines.append("## Results\n")
     lines.append(tables)
     # Figures the tables already show (scene families, pixel maps) are not repeated.
-    figures = [(name, caption) for name, caption in figures if f"]({name})" not in tables]
-    if figures:
+    figures = [(name, caption) for name, caption in figures if f"]({name})" not in tables and name not in unkept]
+    if figures or unkept:
         lines.append("\n## Plots\n")
         for name, caption in figures:
             lines.append(f"![{name}]({name})\n\n{caption}\n")
+        if unkept:
+            lines.append("Also written to this directory, not kept by git (so not linked): "
+                         + ", ".join(f"`{name}`" for name in unkept) + ".\n")
     write_text_atomic(out / REPORT_MD, "\n".join(lines) + "\n")
 
 

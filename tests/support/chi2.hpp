@@ -35,9 +35,7 @@
 // 1 by more than chi2_mass_tolerance.
 //
 // The p-value is the chi-square survival function Q(dof/2, chi2/2), the
-// regularized upper incomplete gamma function: Boost.Math's gamma_q when
-// MCRT_HAVE_BOOST_MATH is defined, otherwise the series / continued-fraction
-// pair of Numerical Recipes (Press et al., 3rd ed., sec. 6.2).
+// regularized upper incomplete gamma function, by Boost.Math's gamma_q.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -53,9 +51,7 @@
 #include "mcrt/core/math.hpp"
 #include "mcrt/core/rng.hpp"
 
-#ifdef MCRT_HAVE_BOOST_MATH
 #include <boost/math/special_functions/gamma.hpp>
-#endif
 
 namespace mcrt::test {
 
@@ -112,42 +108,6 @@ struct chi2_result {
 inline double chi2_survival(double statistic, int dof);
 
 namespace detail {
-
-// Regularized upper incomplete gamma Q(a, x) by Numerical Recipes (3rd ed.,
-// sec. 6.2): the series for P when x < a + 1, Lentz's continued fraction for
-// Q otherwise. Relative accuracy ~1e-14 in the ranges a chi-square test uses.
-inline double gamma_q_series_cf(double a, double x) {
-  if (!(a > 0.0) || !(x >= 0.0)) return std::numeric_limits<double>::quiet_NaN();
-  if (x == 0.0) return 1.0;
-  const double log_prefactor = -x + a * std::log(x) - std::lgamma(a);
-  constexpr int max_iter = 1'000'000;
-  constexpr double eps = 1e-16;
-  if (x < a + 1.0) {
-    double ap = a, del = 1.0 / a, sum = del;
-    for (int n = 0; n < max_iter; ++n) {
-      ap += 1.0;
-      del *= x / ap;
-      sum += del;
-      if (std::abs(del) < std::abs(sum) * eps) break;
-    }
-    return 1.0 - sum * std::exp(log_prefactor);
-  }
-  constexpr double tiny = 1e-300;
-  double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
-  for (int i = 1; i < max_iter; ++i) {
-    const double an = -i * (i - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::abs(d) < tiny) d = tiny;
-    c = b + an / c;
-    if (std::abs(c) < tiny) c = tiny;
-    d = 1.0 / d;
-    const double del = d * c;
-    h *= del;
-    if (std::abs(del - 1.0) < eps) break;
-  }
-  return std::exp(log_prefactor) * h;
-}
 
 // Orthonormal frame around a unit axis in double (Duff et al. 2017).
 struct cap_frame {
@@ -450,13 +410,7 @@ inline std::string format_direction(const dvec3& d) {
 }  // namespace detail
 
 // Regularized upper incomplete gamma function Q(a, x) = Gamma(a, x) / Gamma(a).
-inline double regularized_gamma_q(double a, double x) {
-#ifdef MCRT_HAVE_BOOST_MATH
-  return boost::math::gamma_q(a, x);
-#else
-  return detail::gamma_q_series_cf(a, x);
-#endif
-}
+inline double regularized_gamma_q(double a, double x) { return boost::math::gamma_q(a, x); }
 
 // P(X >= statistic) for X chi-square distributed with dof degrees of freedom.
 inline double chi2_survival(double statistic, int dof) {

@@ -3,6 +3,12 @@
 // Statistically Good Algorithms for Random Number Generation"), the
 // XSH-RR 64/32 variant. Small (16 bytes), fast and seedable per pixel, so an
 // image does not depend on how pixels are shared among threads.
+//
+// pcg32 follows O'Neill's reference implementation pcg_basic.c
+// (pcg32_srandom_r, pcg32_random_r, the default state of PCG32_INITIALIZER):
+// "PCG Random Number Generation for C. Copyright 2014 Melissa O'Neill
+// <oneill@pcg-random.org>. Licensed under the Apache License, Version 2.0";
+// the notice and the licence's text are in THIRD_PARTY.md.
 #include <cstdint>
 
 #include "mcrt/core/math.hpp"

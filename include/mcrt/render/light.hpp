@@ -26,7 +26,7 @@
 namespace mcrt {
 
 // Every shape x strategy the renderer has. The dispatch (core/dispatch.hpp)
-// tests the alternatives in this order, so the strategies of the seed's
+// tests the alternatives in this order, so the strategies of the thesis's
 // scenes come first and the cosine-aware ones after them: a scene
 // that does not use a strategy pays for it at most one predictable compare.
 using light = std::variant<rect_area_sampler, rect_solid_angle_sampler, ellipse_area_sampler,

@@ -33,7 +33,7 @@
 // edge are few (a line of them) and carry most of the image's variance where
 // the camera sees a light (a fixed grid of every stride-th pixel meets them or
 // misses them by where its lines fall: its V is 1000-fold apart between the
-// 400- and the 1024-pixel pilots of the Cornell box with the seed's light). So
+// 400- and the 1024-pixel pilots of the Cornell box with the thesis's light). So
 // the mean of s2_K(E) is taken over two strata: the emitters' footprint in the
 // image (emitter_footprint: where a camera ray may meet a listed light), every
 // pixel of it measured with 2 to K rays (a systematic sample of it where it is

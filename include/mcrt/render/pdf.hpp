@@ -72,7 +72,7 @@ class light_pdf {
   std::size_t count_ = 0;
 };
 
-// Shirley's mixture_pdf with equal weights, as in the book and the seed:
+// Shirley's mixture_pdf with equal weights, as in the book and the thesis:
 // half the directions from the lights, half from the cosine pdf. Where no
 // light faces the point, the cosine pdf alone.
 template <class Light>

@@ -20,7 +20,7 @@
 //
 // The constants are a least-squares fit to the pilot's measured time per
 // light sample (the fastest of 5 runs) over 102 scene and depth settings:
-// the seed's Cornell scenes, the study's size and distance families and
+// the thesis's Cornell scenes, the study's size and distance families and
 // four scenes with 12 further primitives of each type, direct and global
 // light, nee, this machine (bench/rest_cost.py, which prints the fit and
 // the residuals of these constants: 10 % rms, at most 25-29 %, the

@@ -38,7 +38,7 @@
 // and solid-angle sampling, 318 and 451 ns per path at 1.13 light samples
 // per path, leave 265 ns per light sample for the rest); a fixed v_rest =
 // 4 is the value, of those tried (0.25, 1, 4, 16), with the best worst case
-// over the seed's scenes, and `mcrt render` measures the image's noise
+// over the thesis's scenes, and `mcrt render` measures the image's noise
 // instead (docs/auto.md, which also says how far this rule is from the
 // best fixed strategy).
 //

@@ -1,5 +1,7 @@
 #pragma once
-// Uniform sampling of an ellipse by area (the seed, sec. 4.2): the polar map
+// Uniform sampling of an ellipse by area (A. Checa Molina, "Visualizacion
+// realista por Monte-Carlo", undergraduate thesis, Universidad de Granada,
+// 2020, sec. 4.2): the polar map
 // X = c + sqrt(u1) cos(2 pi u2) a1 + sqrt(u1) sin(2 pi u2) a2, whose Jacobian
 // is constant thanks to the square root; density 1/(pi |a1| |a2|) per unit
 // area, d^2 / (|cos| A) per unit solid angle.

@@ -42,7 +42,9 @@ struct light_sample {
 //   solid_angle           uniform in the solid angle the light subtends;
 //   projected_solid_angle proportional to cos theta at the receiver within
 //                         that solid angle (exact for rectangles and
-//                         spheres; for ellipses see README);
+//                         spheres; for ellipses exact where the map is
+//                         well conditioned, the bilinear pre-warp
+//                         elsewhere: projected_spherical_ellipse.hpp);
 //   bilinear_solid_angle  the solid-angle map pre-warped by a bilinear
 //                         approximation of cos theta on its unit square
 //                         (Hart et al. 2020, as pbrt-v4), a comparison

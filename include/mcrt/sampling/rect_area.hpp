@@ -1,5 +1,7 @@
 #pragma once
-// Uniform sampling of a rectangle by area (the seed, sec. 4.1):
+// Uniform sampling of a rectangle by area (Shirley, "The Rest of Your Life",
+// sec. 9; A. Checa Molina, "Visualizacion realista por Monte-Carlo",
+// undergraduate thesis, Universidad de Granada, 2020, sec. 4.1):
 // X = corner + u1 e1 + u2 e2, with density 1/A per unit area, converted to a
 // density per unit solid angle at the observer by d^2 / (|cos| A).
 #include "mcrt/geometry/rect.hpp"

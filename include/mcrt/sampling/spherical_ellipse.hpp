@@ -4,7 +4,9 @@
 // spherical ellipse of Guillen, Urena, King, Fajardo, Georgiev, Lopez-Moreno
 // and Jarabo 2017, "Area-Preserving Parametrizations for Spherical Ellipses"
 // (EGSR 2017), whose area equation Omega_p(phi) = u1 Omega is the paper's
-// eq. 13 (as the seed, app. A.4, numbers it), with the reduction of an arbitrary
+// eq. 13 (so numbered in A. Checa Molina, "Visualizacion realista por
+// Monte-Carlo", undergraduate thesis, Universidad de Granada, 2020, app. A.4,
+// below [CM20]), with the reduction of an arbitrary
 // planar ellipse to a canonical elliptic cone (Heitz 2017, "Analytical
 // calculation of the solid angle subtended by an arbitrarily positioned
 // ellipsoid to a point source", NIMA 2017: eigen-decomposition of the cone's
@@ -38,9 +40,10 @@
 //                              the step by local Gauss-Legendre instead of
 //                              evaluating the closed form again), residual
 //                              <= 1e-9 Omega;
-//   bisection_simpson_solver   the seed's method (sec. 4.2, app. A.4): 10
-//                              bisection steps in theta, Omega_p by a
-//                              10-interval composite Simpson rule of 2 h_p.
+//   bisection_simpson_solver   the method of [CM20] (sec. 4.2, app. A.4), a
+//                              baseline for comparison: 10 bisection steps
+//                              in theta, Omega_p by a 10-interval composite
+//                              Simpson rule of 2 h_p.
 //
 // Fallback. Where the spherical map cannot be set up accurately the light
 // is sampled by area (ellipse_area.hpp) and evaluated with the exact area
@@ -295,21 +298,22 @@ struct newton_carlson_solver {
   }
 };
 
-// The seed's solver (sec. 4.2 and app. A.4): Omega_p(theta) by a composite
-// Simpson rule of the paper's integrand 2 h_p(theta) (eq. 13) with 10
-// intervals on [0, beta] and [0, |theta|], and theta by 10 bisection steps
-// on [-beta, beta]. The integrand has square-root zeros at +-beta, so the
-// rule converges as n^-1.5 and its Omega is low by ~2e-3 relative; pdf() is
-// 1 / that Omega, consistent with sample() but not with the true density.
-// The seed also stopped bisection once the bracket was narrower than 1e-3
-// rad, which for lights under 1e-3 rad collapses every sample onto theta =
-// 0; that absolute tolerance is left out.
+// The solver of [CM20] (sec. 4.2 and app. A.4), a baseline for comparison:
+// Omega_p(theta) by a composite Simpson rule of the paper's integrand
+// 2 h_p(theta) (eq. 13) with 10 intervals on [0, beta] and [0, |theta|], and
+// theta by 10 bisection steps on [-beta, beta]. The integrand has
+// square-root zeros at +-beta, so the rule converges as n^-1.5 and its Omega
+// is low by ~2e-3 relative; pdf() is 1 / that Omega, consistent with
+// sample() but not with the true density. [CM20] also stops bisection once
+// the bracket is narrower than 1e-3 rad; that absolute tolerance is not
+// reproduced, since for lights under 1e-3 rad it puts every sample on
+// theta = 0.
 struct bisection_simpson_solver {
   static constexpr int simpson_intervals = 10;
   static constexpr int bisection_steps = 10;
 
   // 2 h_p(theta), h_p = x_max(theta) the chord half-width on the sphere
-  // (eq. 13; seed app. A.4).
+  // (eq. 13; [CM20] app. A.4).
   static double integrand(const spherical_ellipse& se, double theta) {
     const double a2 = se.a * se.a, b2 = se.b * se.b;
     const double ct = se.a / std::sqrt(1.0 + a2), p = 1.0 / b2, m = (a2 - b2) / (a2 + 1.0);
