@@ -90,7 +90,7 @@ SAMPLER_DESCRIPTIONS = {
     "BM_SampleEllipseArea": "disk/ellipse, by area",
     "BM_SampleEllipseSolidAngle": "disk/ellipse, by solid angle (parallel map, Newton)",
     "BM_SampleEllipseSolidAnglePolar": "disk/ellipse, by solid angle (polar map, Newton)",
-    "BM_SampleEllipseSolidAngleBisectionSimpson": "disk/ellipse, by solid angle (parallel map, the seed's bisection + Simpson)",
+    "BM_SampleEllipseSolidAngleBisectionSimpson": "disk/ellipse, by solid angle (parallel map, the thesis's bisection + Simpson)",
 }
 
 NOT_AVAILABLE_MARKER = "not available in this build"

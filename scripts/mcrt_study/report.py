@@ -446,7 +446,7 @@ def scene_lines(scenes: list[SceneInfo]) -> list[str]:
     rows = [[sc.name, sc.family or "–", fmt(sc.family_param), fmt(sc.light_solid_angle)] for sc in scenes]
     return ["### Scenes\n",
             "Generated families (scene files in `scenes/` of this directory; see "
-            "`scripts/mcrt_study/scenes.py`): size_* — light area relative to the seed's 130×105; "
+            "`scripts/mcrt_study/scenes.py`): size_* — light area relative to the Cornell box's 130×105 ceiling light; "
             "distance — light height over the floor relative to its size (130). Solid angle (sr) of the "
             "first light seen from the box's centre (278, 278, 279.5), for the distance family from the "
             "floor point under the light.\n",
