@@ -7,7 +7,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(cmake g++ make pkg-config libglm-dev libopenimageio-dev nlohmann-json3-dev libcli11-dev
-          libgtest-dev libbenchmark-dev libboost-math-dev python3 python3-venv)
+          libgtest-dev libbenchmark-dev libboost-math-dev zlib1g-dev python3 python3-venv)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
