@@ -16,6 +16,7 @@
 #include "mcrt/geometry/rect.hpp"
 #include "mcrt/geometry/sphere.hpp"
 #include "mcrt/geometry/transform.hpp"
+#include "mcrt/geometry/triangle_mesh.hpp"
 #include "mcrt/io/ppm.hpp"
 #include "mcrt/materials/material.hpp"
 #include "mcrt/render/camera.hpp"
@@ -59,4 +60,5 @@
 #include "mcrt/sampling/spherical_ellipse.hpp"
 #include "mcrt/sampling/spherical_ellipse_polar.hpp"
 #include "mcrt/sampling/spherical_rectangle.hpp"
+#include "mcrt/sampling/triangle_area.hpp"
 #include "mcrt/sampling/warp.hpp"
