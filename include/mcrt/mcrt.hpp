@@ -1,6 +1,7 @@
 #pragma once
 // mcrt: a header-only Monte-Carlo path tracer for studying direct sampling
 // of area lights. Include this for everything, or the single headers.
+#include "mcrt/accel/bvh.hpp"
 #include "mcrt/core/carlson.hpp"
 #include "mcrt/core/dispatch.hpp"
 #include "mcrt/core/fast_math.hpp"

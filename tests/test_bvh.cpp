@@ -1,0 +1,192 @@
+// The bounding volume hierarchy (accel/bvh.hpp) against brute force: over
+// random triangle soups, the closest hit (its t and its primitive) and the
+// any-hit query of shadow segments are the same as testing every primitive,
+// for rays in random directions and along the coordinate axes (zero
+// direction components: the slab test's 0 * inf), from outside and inside the
+// scene's box; and the tree's invariants: its order is a permutation, every
+// node's box holds its children's and its primitives', leaves hold at most
+// max_leaf_size, its depth fits the traversal's stack, also for degenerate
+// inputs (every primitive in one place, coordinates spread over 30 decades).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <functional>
+#include <limits>
+#include <memory>
+
+#include "mcrt/accel/bvh.hpp"
+#include "mcrt/core/rng.hpp"
+#include "mcrt/geometry/triangle_mesh.hpp"
+#include "mcrt/sampling/warp.hpp"
+
+using namespace mcrt;
+
+namespace {
+
+struct soup {
+  std::vector<vec3> a, b, c;
+  std::vector<aabb> bounds() const {
+    std::vector<aabb> out(a.size());
+    for (std::size_t i = 0; i < a.size(); ++i) out[i].grow(a[i]), out[i].grow(b[i]), out[i].grow(c[i]);
+    return out;
+  }
+  float hit(std::uint32_t i, const ray& r, float tmax) const {
+    const auto h = intersect_triangle(r, tmax, a[i], b[i], c[i]);
+    return h ? h->t : infinity;
+  }
+};
+
+soup random_soup(pcg32& rng, int n, float extent, float size) {
+  soup s;
+  for (int i = 0; i < n; ++i) {
+    const vec3 centre{(rng.uniform() - 0.5f) * extent, (rng.uniform() - 0.5f) * extent, (rng.uniform() - 0.5f) * extent};
+    const auto jitter = [&] {
+      return vec3{(rng.uniform() - 0.5f) * size, (rng.uniform() - 0.5f) * size, (rng.uniform() - 0.5f) * size};
+    };
+    s.a.push_back(centre + jitter());
+    s.b.push_back(centre + jitter());
+    s.c.push_back(centre + jitter());
+  }
+  return s;
+}
+
+// Every invariant of the tree; returns its depth.
+int check_tree(const bvh& t, const std::vector<aabb>& bounds) {
+  std::vector<std::uint32_t> sorted = t.order();
+  std::sort(sorted.begin(), sorted.end());
+  for (std::size_t i = 0; i < sorted.size(); ++i) EXPECT_EQ(sorted[i], i) << "the order is not a permutation";
+  int max_depth = 0;
+  std::vector<int> seen(bounds.size(), 0);
+  const std::function<void(std::uint32_t, int)> walk = [&](std::uint32_t k, int depth) {
+    max_depth = std::max(max_depth, depth);
+    const bvh::node& nd = t.nodes()[k];
+    const auto inside = [&](const vec3& lo, const vec3& hi) {
+      return glm::all(glm::greaterThanEqual(lo, nd.lo)) && glm::all(glm::lessThanEqual(hi, nd.hi));
+    };
+    if (nd.count > 0) {
+      EXPECT_LE(nd.count, bvh::max_leaf_size);
+      for (std::uint32_t i = 0; i < nd.count; ++i) {
+        const std::uint32_t prim = t.order()[nd.offset + i];
+        ++seen[prim];
+        EXPECT_TRUE(inside(bounds[prim].lo, bounds[prim].hi)) << "primitive outside its leaf";
+      }
+      return;
+    }
+    const bvh::node &first = t.nodes()[k + 1], &second = t.nodes()[nd.offset];
+    EXPECT_TRUE(inside(first.lo, first.hi) && inside(second.lo, second.hi)) << "child outside its parent";
+    walk(k + 1, depth + 1);
+    walk(nd.offset, depth + 1);
+  };
+  if (!t.empty()) walk(0, 1);
+  for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], 1) << "primitive " << i << " in " << seen[i] << " leaves";
+  return max_depth;
+}
+
+// Closest hit and any-hit of the tree against brute force for `rays` rays.
+void expect_same_as_brute_force(const soup& s, const bvh& tree, pcg32& rng, int rays, float extent,
+                                double min_hits = 0.2, double min_blocked = 0.1) {
+  const std::size_t n = s.a.size();
+  int hits = 0, blocked = 0;
+  for (int k = 0; k < rays; ++k) {
+    const vec3 o{(rng.uniform() - 0.5f) * 1.5f * extent, (rng.uniform() - 0.5f) * 1.5f * extent,
+                 (rng.uniform() - 0.5f) * 1.5f * extent};
+    vec3 d = square_to_uniform_sphere(rng.uniform2());
+    if (k % 2 == 1) {  // towards a random primitive's centroid, so that many rays hit
+      const std::size_t i = static_cast<std::size_t>(rng.uniform() * float(n));
+      const vec3 to = (s.a[i] + s.b[i] + s.c[i]) / 3.0f - o;
+      if (glm::length(to) > 0.0f) d = glm::normalize(to);
+    }
+    if (k % 5 == 0) {  // along an axis: two zero components
+      d = vec3(0.0f);
+      d[k % 3] = (k % 2) ? 1.0f : -1.0f;
+    }
+    const ray r{o, d};
+    float brute_t = infinity;
+    std::int64_t brute_i = -1;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const float t = s.hit(i, r, brute_t);
+      if (t < brute_t) brute_t = t, brute_i = i;
+    }
+    float tree_t = infinity;
+    const std::int64_t tree_i = tree.closest(r, 0.0f, tree_t, [&](std::uint32_t i, float, float tmax) { return s.hit(i, r, tmax); });
+    ASSERT_EQ(tree_t, brute_t) << "ray " << k;
+    if (tree_i != brute_i) {  // only a tie may name another primitive
+      ASSERT_GE(tree_i, 0);
+      EXPECT_EQ(s.hit(static_cast<std::uint32_t>(tree_i), r, infinity), brute_t) << "ray " << k;
+    }
+    hits += brute_i >= 0;
+    // A shadow segment to a random point: blocked iff some hit lies before it.
+    const float seg = rng.uniform() * 2.0f * extent;
+    bool brute_any = false;
+    for (std::uint32_t i = 0; i < n && !brute_any; ++i) brute_any = s.hit(i, r, seg) < seg;
+    const bool tree_any = tree.any(r, 0.0f, seg, [&](std::uint32_t i, float, float tmax) { return s.hit(i, r, tmax) < tmax; });
+    ASSERT_EQ(tree_any, brute_any) << "ray " << k;
+    blocked += brute_any;
+  }
+  // Enough hits and blocked segments for the comparison to mean something.
+  EXPECT_GT(hits, min_hits * rays);
+  EXPECT_GT(blocked, min_blocked * rays);
+}
+
+}  // namespace
+
+TEST(Bvh, ClosestAndAnyHitAreThoseOfBruteForce) {
+  pcg32 rng(1, 2);
+  for (const int n : {1, 2, 5, 100, 3000}) {
+    const soup s = random_soup(rng, n, 10.0f, n > 100 ? 1.0f : 4.0f);
+    const std::vector<aabb> b = s.bounds();
+    const bvh tree(b);
+    check_tree(tree, b);
+    expect_same_as_brute_force(s, tree, rng, 3000, 10.0f);
+  }
+}
+
+TEST(Bvh, DegenerateInputs) {
+  pcg32 rng(3, 4);
+  // Every primitive in one place: the build halves by count.
+  soup same;
+  for (int i = 0; i < 1000; ++i) same.a.push_back({0, 0, 0}), same.b.push_back({1, 0, 0}), same.c.push_back({0, 1, 0});
+  const bvh t1(same.bounds());
+  EXPECT_LE(check_tree(t1, same.bounds()), 12);
+  float t = infinity;
+  EXPECT_GE(t1.closest({{0.2f, 0.2f, 1}, {0, 0, -1}}, 0.0f, t, [&](std::uint32_t i, float, float tmax) { return same.hit(i, {{0.2f, 0.2f, 1}, {0, 0, -1}}, tmax); }), 0);
+  EXPECT_EQ(t, 1.0f);
+  // Coordinates spread over 30 decades along a line: a lopsided tree must
+  // still fit the traversal's stack.
+  soup line;
+  for (int i = 0; i < 4000; ++i) {
+    const float x = std::pow(1.02f, float(i)) * 1e-5f;
+    line.a.push_back({x, 0, 0}), line.b.push_back({x, 1, 0}), line.c.push_back({x, 0, 1});
+  }
+  const bvh t2(line.bounds());
+  EXPECT_LE(check_tree(t2, line.bounds()), 128);
+  expect_same_as_brute_force(line, t2, rng, 1000, 2.0f, 0.05, 0.05);
+  // No primitives.
+  const bvh t3(std::vector<aabb>{});
+  float t_empty = infinity;
+  EXPECT_EQ(t3.closest({{0, 0, 0}, {0, 0, 1}}, 0.0f, t_empty, [](std::uint32_t, float, float) { return 0.0f; }), -1);
+  EXPECT_FALSE(t3.any({{0, 0, 0}, {0, 0, 1}}, 0.0f, infinity, [](std::uint32_t, float, float) { return true; }));
+}
+
+TEST(Bvh, TraversalTestsFewPrimitivesPerRay) {
+  // On 20000 small triangles a ray should test a few dozen, not thousands:
+  // the tree is a hierarchy, not a list.
+  pcg32 rng(5, 6);
+  const soup s = random_soup(rng, 20000, 100.0f, 1.0f);
+  const bvh tree(s.bounds());
+  check_tree(tree, s.bounds());
+  long long tests = 0;
+  const int rays = 2000;
+  for (int k = 0; k < rays; ++k) {
+    const ray r{{(rng.uniform() - 0.5f) * 100.0f, (rng.uniform() - 0.5f) * 100.0f, -80.0f},
+                glm::normalize(vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, 1.0f))};
+    float t = infinity;
+    tree.closest(r, 0.0f, t, [&](std::uint32_t i, float, float tmax) {
+      ++tests;
+      return s.hit(i, r, tmax);
+    });
+  }
+  const double per_ray = double(tests) / rays;
+  std::printf("primitives tested per ray: %.1f of %zu\n", per_ray, s.a.size());
+  EXPECT_LT(per_ray, 200.0);
+}
