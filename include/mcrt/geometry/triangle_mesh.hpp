@@ -67,7 +67,8 @@ inline vec3 permute(const vec3& v, int x, int y, int z) { return {v[x], v[y], v[
 inline std::optional<triangle_hit> intersect_triangle(const ray& r, float tmax, const vec3& p0, const vec3& p1,
                                                       const vec3& p2) {
   // Degenerate triangles (zero area) are never hit.
-  if (glm::length(glm::cross(p2 - p0, p1 - p0)) == 0.0f) return std::nullopt;
+  const vec3 c = glm::cross(p2 - p0, p1 - p0);
+  if (glm::dot(c, c) == 0.0f) return std::nullopt;
   vec3 p0t = p0 - r.o, p1t = p1 - r.o, p2t = p2 - r.o;
   const int kz = detail::max_dimension(glm::abs(r.d));
   const int kx = kz == 2 ? 0 : kz + 1, ky = kx == 2 ? 0 : kx + 1;

@@ -22,6 +22,7 @@
 #include "mcrt/sampling/spherical_ellipse.hpp"
 #include "mcrt/sampling/spherical_ellipse_polar.hpp"
 #include "mcrt/sampling/spherical_rectangle.hpp"
+#include "mcrt/sampling/triangle_area.hpp"
 
 namespace mcrt {
 
@@ -34,13 +35,13 @@ using light = std::variant<rect_area_sampler, rect_solid_angle_sampler, ellipse_
                            rect_projected_solid_angle_sampler, sphere_projected_solid_angle_sampler,
                            ellipse_projected_solid_angle_sampler, sphere_area_sampler,
                            rect_bilinear_solid_angle_sampler, ellipse_bilinear_solid_angle_sampler,
-                           rect_auto_sampler, ellipse_auto_sampler, sphere_auto_sampler>;
+                           rect_auto_sampler, ellipse_auto_sampler, sphere_auto_sampler, triangle_area_sampler>;
 
 // The strategy a light-sampling class implements (--stats, mcrt samples).
 template <class S>
 constexpr light_sampling strategy_of() {
   if constexpr (std::is_same_v<S, rect_area_sampler> || std::is_same_v<S, ellipse_area_sampler> ||
-                std::is_same_v<S, sphere_area_sampler>)
+                std::is_same_v<S, sphere_area_sampler> || std::is_same_v<S, triangle_area_sampler>)
     return light_sampling::area;
   else if constexpr (std::is_same_v<S, rect_projected_solid_angle_sampler> ||
                      std::is_same_v<S, sphere_projected_solid_angle_sampler> ||
@@ -130,6 +131,7 @@ inline float pdf(const light& l, const vec3& o, const vec3& n, const vec3& dir) 
 inline float surface_area(const rect& r) { return r.area; }
 inline float surface_area(const ellipse& e) { return e.area; }
 inline float surface_area(const sphere& s) { return 2.0f * two_pi * s.radius * s.radius; }
+inline float surface_area(const triangle& t) { return t.area(); }
 inline float surface_area(const light& l) {
   return dispatch(l, [](const auto& s) { return surface_area(s.shape); });
 }

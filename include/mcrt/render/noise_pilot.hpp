@@ -197,6 +197,7 @@ inline std::vector<vec3> hull_points(const rect& r) {
 inline std::vector<vec3> hull_points(const ellipse& e) {
   return {e.center + e.a1 + e.a2, e.center + e.a1 - e.a2, e.center - e.a1 + e.a2, e.center - e.a1 - e.a2};
 }
+inline std::vector<vec3> hull_points(const triangle& t) { return {t.vertex(0), t.vertex(1), t.vertex(2)}; }
 inline std::vector<vec3> hull_points(const sphere& s) {
   std::vector<vec3> v;
   for (int i = 0; i < 8; ++i)

@@ -11,6 +11,7 @@
 #include "mcrt/geometry/ellipse.hpp"
 #include "mcrt/geometry/rect.hpp"
 #include "mcrt/geometry/sphere.hpp"
+#include "mcrt/geometry/triangle_mesh.hpp"
 #include "mcrt/materials/material.hpp"
 #include "mcrt/render/light.hpp"
 
@@ -154,6 +155,8 @@ struct basic_scene {
   }
 };
 
-using scene = basic_scene<rect, ellipse, sphere, box>;
+// Triangles (of meshes) are tested one by one, after the analytic shapes: a
+// scene without them pays one empty-list check per ray.
+using scene = basic_scene<rect, ellipse, sphere, box, triangle>;
 
 }  // namespace mcrt
