@@ -21,6 +21,19 @@ class camera {
     upper_left_ = origin_ - 0.5f * horizontal_ + 0.5f * vertical_ - w;
   }
 
+  // A pinhole camera given by its image plane: the eye, the plane's
+  // upper-left corner and its horizontal (to the image's right) and vertical
+  // (upwards) extents. Any frame, a mirrored one included (pbrt-v4's cameras,
+  // whose camera-from-world matrix may contain a reflection).
+  static camera from_image_plane(const vec3& eye, const vec3& upper_left, const vec3& horizontal, const vec3& vertical) {
+    camera c;
+    c.origin_ = eye;
+    c.upper_left_ = upper_left;
+    c.horizontal_ = horizontal;
+    c.vertical_ = vertical;
+    return c;
+  }
+
   // (s, t) in [0,1]^2 over the image, s to the right, t downwards (row order).
   ray generate(float s, float t) const {
     return {origin_, upper_left_ + s * horizontal_ - t * vertical_ - origin_};
@@ -30,7 +43,9 @@ class camera {
   // false where p is not in front of the camera (on or behind the plane
   // through the eye parallel to the image).
   bool project(const vec3& p, float& s, float& t) const {
-    const vec3 w = glm::normalize(glm::cross(horizontal_, vertical_));  // towards the viewer
+    vec3 w = glm::normalize(glm::cross(horizontal_, vertical_));  // towards the viewer ...
+    const vec3 centre = upper_left_ + 0.5f * horizontal_ - 0.5f * vertical_;
+    if (glm::dot(centre - origin_, w) > 0.0f) w = -w;                // ... also for a mirrored frame
     const vec3 d = p - origin_;
     const float depth = -glm::dot(d, w);
     if (!(depth > 0.0f)) return false;
