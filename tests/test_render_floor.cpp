@@ -34,6 +34,7 @@
 
 #include "mcrt/mcrt.hpp"
 #include "support/lambert.hpp"
+#include "support/light_strategies.hpp"
 #include "support/radiance_estimate.hpp"
 
 using namespace mcrt;
@@ -84,49 +85,9 @@ std::string combo_name(const ::testing::TestParamInfo<combo>& info) {
 const auto integrators = ::testing::Values(integrator_kind::mixture, integrator_kind::nee, integrator_kind::mis);
 const auto samplers = ::testing::Values(sampler_kind::independent, sampler_kind::stratified, sampler_kind::sobol);
 
-// The light (material 1) with the strategy of the given name.
-void add_rect_light(scene& sc, const rect& r, const std::string& strategy) {
-  if (strategy == "area")
-    sc.add_light(rect_area_sampler{r}, 1);
-  else if (strategy == "solid-angle")
-    sc.add_light(rect_solid_angle_sampler{r}, 1);
-  else if (strategy == "projected-solid-angle")
-    sc.add_light(rect_projected_solid_angle_sampler{r}, 1);
-  else if (strategy == "bilinear-solid-angle")
-    sc.add_light(rect_bilinear_solid_angle_sampler{r}, 1);
-  else if (strategy == "auto")
-    sc.add_light(rect_auto_sampler{r}, 1);
-  else
-    FAIL() << "no rectangle strategy " << strategy;
-}
-void add_disk_light(scene& sc, const ellipse& e, const std::string& strategy) {
-  if (strategy == "area")
-    sc.add_light(ellipse_area_sampler{e}, 1);
-  else if (strategy == "solid-angle")
-    sc.add_light(ellipse_solid_angle_sampler{e}, 1);
-  else if (strategy == "polar")
-    sc.add_light(ellipse_polar_solid_angle_sampler{e}, 1);
-  else if (strategy == "projected-solid-angle")
-    sc.add_light(ellipse_projected_solid_angle_sampler{e}, 1);
-  else if (strategy == "bilinear-solid-angle")
-    sc.add_light(ellipse_bilinear_solid_angle_sampler{e}, 1);
-  else if (strategy == "auto")
-    sc.add_light(ellipse_auto_sampler{e}, 1);
-  else
-    FAIL() << "no ellipse strategy " << strategy;
-}
-void add_sphere_light(scene& sc, const sphere& sp, const std::string& strategy) {
-  if (strategy == "area")
-    sc.add_light(sphere_area_sampler{sp}, 1);
-  else if (strategy == "solid-angle")
-    sc.add_light(sphere_cone_sampler{sp}, 1);
-  else if (strategy == "projected-solid-angle")
-    sc.add_light(sphere_projected_solid_angle_sampler{sp}, 1);
-  else if (strategy == "auto")
-    sc.add_light(sphere_auto_sampler{sp}, 1);
-  else
-    FAIL() << "no sphere strategy " << strategy;
-}
+using test::add_disk_light;
+using test::add_rect_light;
+using test::add_sphere_light;
 
 // Radiance leaving the floor at (x, 0, z) under a sphere wholly above it:
 // albedo/pi * L * pi sin^2 alpha cos theta_c (the projected solid angle of a

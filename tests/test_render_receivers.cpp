@@ -29,6 +29,7 @@
 
 #include "mcrt/mcrt.hpp"
 #include "support/lambert.hpp"
+#include "support/light_strategies.hpp"
 #include "support/radiance_estimate.hpp"
 
 using namespace mcrt;
@@ -54,21 +55,6 @@ rect turned_ceiling_light(float degrees) {
 // y, then moved to (265, 0, 295).
 box tall_box() { return box{{0, 0, 0}, {165, 330, 165}, rigid_y::make(15.0f, {265, 0, 295})}; }
 
-void add_light(scene& sc, const rect& r, const std::string& strategy) {
-  if (strategy == "area")
-    sc.add_light(rect_area_sampler{r}, 1);
-  else if (strategy == "solid-angle")
-    sc.add_light(rect_solid_angle_sampler{r}, 1);
-  else if (strategy == "projected-solid-angle")
-    sc.add_light(rect_projected_solid_angle_sampler{r}, 1);
-  else if (strategy == "bilinear-solid-angle")
-    sc.add_light(rect_bilinear_solid_angle_sampler{r}, 1);
-  else if (strategy == "auto")
-    sc.add_light(rect_auto_sampler{r}, 1);
-  else
-    FAIL() << "no rectangle strategy " << strategy;
-}
-
 using combo = std::tuple<integrator_kind, std::string, int>;
 
 }  // namespace
@@ -83,7 +69,7 @@ TEST_P(TallBoxFrontFace, MatchesLambertsFormulaAtGrazingAngles) {
   scene sc;
   sc.materials = {lambertian{color(albedo)}, diffuse_light{color(emit)}};
   sc.add(b, 0);
-  add_light(sc, light, strategy);
+  test::add_rect_light(sc, light, strategy);
   sc.ray_epsilon = 2e-6f * 555.0f;  // what the scene loader sets for the Cornell box
   EXPECT_EQ(sc.axis_rects.size(), degrees == 0 ? 1u : 0u) << "only the unturned light is axis-aligned";
 

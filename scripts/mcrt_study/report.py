@@ -304,10 +304,8 @@ def build_tables(rows: list[dict], settings: Settings, scenes: list[SceneInfo],
     return text, summary, analysis
 
 
-def machine_info(out: Path | None = None) -> dict[str, str]:
-    """CPU model, core count, OS, and the repository's git commit; changes
-    under `out` (the study's own outputs, rewritten by the run) do not count
-    as uncommitted changes."""
+def machine_info() -> dict[str, str]:
+    """CPU model, core count, OS and Python version (the renderer's commit: renderer_commit)."""
     cpu = platform.processor() or platform.machine()
     try:
         for line in Path("/proc/cpuinfo").read_text(encoding="utf-8").splitlines():
@@ -316,25 +314,8 @@ def machine_info(out: Path | None = None) -> dict[str, str]:
                 break
     except OSError:
         pass
-    commit = "unknown"
-    try:
-        head = subprocess.run(["git", "-C", str(REPO_ROOT), "rev-parse", "HEAD"],
-                              capture_output=True, text=True, check=True).stdout.strip()
-        exclude = []
-        if out is not None:
-            try:
-                exclude = [":(exclude)" + str(Path(out).resolve().relative_to(REPO_ROOT.resolve()))]
-            except ValueError:  # outside the repository
-                pass
-        dirty = subprocess.run(["git", "-C", str(REPO_ROOT), "status", "--porcelain", "--untracked-files=no",
-                                "--", "."] + exclude,
-                               capture_output=True, text=True, check=True).stdout.strip()
-        commit = head + (" (with uncommitted changes)" if dirty else "")
-    except (OSError, subprocess.CalledProcessError):
-        pass
     return {"cpu": cpu, "cores": str(os.cpu_count() or "?"),
-            "os": f"{platform.system()} {platform.release()}", "commit": commit,
-            "python": platform.python_version()}
+            "os": f"{platform.system()} {platform.release()}", "python": platform.python_version()}
 
 
 # The sources of the renderer (the mcrt executable) and of the sampler benchmark the study runs:
@@ -461,7 +442,7 @@ def write_report(settings: Settings, scenes: list[SceneInfo], tables: str,
     unkept = unkept_figures(out, [name for name, _ in figures])
     tables = drop_figure_links(tables, unkept)
     write_text_atomic(out / TABLES_MD, tables)
-    info = machine_info(out)
+    info = machine_info()
     sources = RENDERER_SOURCES + (BENCH_SOURCES if settings.bench is not None and settings.bench.is_file() else [])
     renderer, changed = renderer_commit(out, sources)
     state = read_state(out / STATE_JSON)

@@ -40,7 +40,7 @@ struct mixture_integrator {
 
       if (const auto* lam = std::get_if<lambertian>(&m)) {
         const vec3 n = rec.facing_normal();
-        const vec3 origin = rec.p + rec.offset * n;  // rec.spawn_origin(n): the sampled directions leave on the facing side
+        const vec3 origin = rec.spawn_origin(n);  // the sampled directions leave on the facing side
         const cosine_pdf cos_pdf(n);
         const light_pdf<light> lights(sc.lights, origin, n);
         const mixture_pdf<light> mix(cos_pdf, lights);

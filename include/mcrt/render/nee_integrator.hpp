@@ -91,7 +91,7 @@ struct next_event_integrator {
       if (const auto* lam = std::get_if<lambertian>(&m)) {
         const vec3 n = rec.facing_normal();
         // Light samples and the continuation leave on the facing side.
-        const vec3 p = rec.p + rec.offset * n;  // rec.spawn_origin(n): n is the facing side
+        const vec3 p = rec.spawn_origin(n);
         const light_selection sel(sc, p, n, set.choose);
         radiance += throughput * sample_direct_light<Weights>(sc, p, n, lam->albedo, sel, ps, b, set);
         if (depth >= set.rr_depth && !survive_roulette(throughput, [&] { return ps.get1d(b + layout::roulette); }))

@@ -64,6 +64,24 @@ class RendererCommitTest(unittest.TestCase):
             git(self.repo, "clean", "-fdq")
             self.assertEqual(report.renderer_commit(self.repo / "results"), (self.renderer, False))
 
+    def test_outputs_inside_the_sources_are_the_runs(self):
+        # A study's output directory among the renderer's sources: what the run rewrites there is
+        # its own output, not a change of the renderer; the same change counts when that
+        # directory is not named, and an output directory outside the repository excludes nothing.
+        out = self.repo / "src" / "study"
+        out.mkdir()
+        (out / "README.md").write_text("old report\n")
+        git(self.repo, "add", ".")
+        git(self.repo, "commit", "-q", "-m", "a report among the sources")
+        renderer = git(self.repo, "log", "-1", "--format=%h")
+        (out / "README.md").write_text("the run's new report\n")
+        self.assertEqual(report.renderer_commit(out), (renderer, False))
+        self.assertEqual(report.renderer_commit(), (renderer, True))
+        with tempfile.TemporaryDirectory() as elsewhere:
+            self.assertEqual(report.renderer_commit(Path(elsewhere)), (renderer, True))
+        (self.repo / "src" / "main.cpp").write_text("changed renderer\n")
+        self.assertEqual(report.renderer_commit(out), (renderer, True))
+
     def test_outside_a_repository(self):
         with tempfile.TemporaryDirectory() as elsewhere, mock.patch.object(report, "REPO_ROOT", Path(elsewhere)):
             self.assertEqual(report.renderer_commit(), ("unknown", False))
