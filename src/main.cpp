@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <limits>
 #include <optional>
@@ -24,7 +25,9 @@ using namespace mcrt::cli;
 
 struct render_options {
   std::string scene, output, stats, light_sampling, ellipse_map = "parallel";
-  std::string integrator = "mis", sampler = "sobol", mis_heuristic = "power", light_select = "power";
+  // sampler and light_select: "" where the command line is silent (the
+  // scene file's, else sobol and power).
+  std::string integrator = "mis", sampler, mis_heuristic = "power", light_select;
   std::optional<int> spp, width, height, max_depth, rr_depth;
   std::optional<unsigned> threads;
   std::optional<float> auto_rest_cost, auto_rest_variance;
@@ -96,28 +99,37 @@ int run_render(const render_options& opt) {
   // strategy (auto_strategy.hpp, auto_params; render/noise_pilot.hpp).
   const bool pilot = !opt.auto_rest_variance;
   loaded_scene ls = load_scene(opt.scene, strategy, map, ap, pilot);
-  const std::string output = opt.output.empty() ? ls.name + ".exr" : opt.output;
+  // Without -o: a pbrt-v4 file's Film filename (in the current directory), else SCENE-NAME.exr.
+  const std::string output = !opt.output.empty() ? opt.output
+                             : !ls.output.empty() ? std::filesystem::path(ls.output).filename().string()
+                                                  : ls.name + ".exr";
   check_writable(output, true);
   if (!opt.stats.empty()) check_writable(opt.stats, false);
 
   render_settings rs;
   // The camera keeps the scene's aspect ratio: --width/--height change the
   // sampling resolution, not the view.
-  const camera cam(ls.cam.lookfrom, ls.cam.lookat, ls.cam.vup, ls.cam.vfov,
-                   static_cast<float>(ls.cam.width) / static_cast<float>(ls.cam.height));
   rs.width = opt.width.value_or(ls.cam.width);
   rs.height = opt.height.value_or(ls.cam.height);
+  const camera cam = ls.make_camera(rs.width, rs.height);
   rs.spp = opt.spp.value_or(ls.spp);
   rs.max_depth = opt.max_depth.value_or(ls.max_depth);
   if (opt.rr_depth) rs.rr_depth = *opt.rr_depth;
   rs.seed = opt.seed;
   rs.threads = opt.threads.value_or(0u);
   rs.integrator = opt.integrator == "nee" ? integrator_kind::nee : opt.integrator == "mis" ? integrator_kind::mis : integrator_kind::mixture;
-  rs.sampler = opt.sampler == "stratified" ? sampler_kind::stratified
-               : opt.sampler == "sobol"    ? sampler_kind::sobol
-                                           : sampler_kind::independent;
+  const std::string sampler_name = !opt.sampler.empty() ? opt.sampler : !ls.sampler.empty() ? ls.sampler : "sobol";
+  const std::string light_select = !opt.light_select.empty() ? opt.light_select
+                                   : !ls.light_select.empty() ? ls.light_select
+                                                              : "power";
+  rs.sampler = sampler_name == "stratified" ? sampler_kind::stratified
+               : sampler_name == "sobol"    ? sampler_kind::sobol
+                                            : sampler_kind::independent;
   rs.heuristic = opt.mis_heuristic == "balance" ? mis_heuristic::balance : mis_heuristic::power;
-  rs.choose = opt.light_select == "uniform" ? light_choice::uniform : light_choice::power;
+  rs.filter = ls.filter == "gaussian" ? pixel_filter::gaussian(ls.filter_radius, ls.filter_sigma)
+              : ls.filter == "triangle" ? pixel_filter::triangle(ls.filter_radius)
+                                        : pixel_filter::box(ls.filter_radius);
+  rs.choose = light_select == "uniform" ? light_choice::uniform : light_choice::power;
 
   std::optional<noise_pilot_result> noise;
   double edge_factor = 1.0;  // kappa_E (render/noise_pilot.hpp)
@@ -166,7 +178,7 @@ int run_render(const render_options& opt) {
                {"mcrt:light_sampling", strategy_used},
                {"mcrt:ellipse_map", opt.ellipse_map},
                {"mcrt:integrator", opt.integrator},
-               {"mcrt:sampler", opt.sampler},
+               {"mcrt:sampler", sampler_name},
                {"mcrt:scene", ls.name}});
   if (!opt.stats.empty()) {
     nlohmann::ordered_json j;
@@ -178,9 +190,9 @@ int run_render(const render_options& opt) {
     j["samples_per_second"] = samples / res.seconds;
     j["light_sampling"] = strategy_used;
     j["integrator"] = opt.integrator;
-    j["sampler"] = opt.sampler;
+    j["sampler"] = sampler_name;
     j["mis_heuristic"] = opt.mis_heuristic;
-    j["light_select"] = opt.light_select;
+    j["light_select"] = light_select;
     j["ellipse_map"] = opt.ellipse_map;
     j["seed"] = rs.seed;
     j["max_depth"] = rs.max_depth;
@@ -260,7 +272,7 @@ int main(int argc, char** argv) {
 
   render_options ro;
   CLI::App* render_cmd = app.add_subcommand("render", "Render a scene file to an image");
-  render_cmd->add_option("scene", ro.scene, "Scene file (JSON)")->required();
+  render_cmd->add_option("scene", ro.scene, "Scene file (JSON, or pbrt-v4: .pbrt, .pbrt.gz)")->required();
   render_cmd->add_option("-o,--output", ro.output, "Output image: .exr, .png or .ppm (default SCENE-NAME.exr)");
   render_cmd->add_option("--spp", ro.spp, "Samples per pixel (overrides the scene)");
   render_cmd->add_option("--width", ro.width, "Image width in pixels (overrides the scene; keeps the view)");
@@ -289,12 +301,14 @@ int main(int argc, char** argv) {
                          "Estimator: mis (next-event estimation with multiple importance sampling, default), nee "
                          "(next-event estimation) or mixture (Shirley's mixture pdf)")
       ->check(CLI::IsMember({"mixture", "nee", "mis"}));
-  render_cmd->add_option("--sampler", ro.sampler, "Sample generator: independent, stratified or sobol (default: sobol)")
+  render_cmd->add_option("--sampler", ro.sampler,
+                         "Sample generator: independent, stratified or sobol (default: the pbrt-v4 file's, else sobol)")
       ->check(CLI::IsMember({"independent", "stratified", "sobol"}));
   render_cmd->add_option("--mis-heuristic", ro.mis_heuristic, "Weights of --integrator mis: power (beta = 2, default) or balance")
       ->check(CLI::IsMember({"power", "balance"}));
   render_cmd->add_option("--light-select", ro.light_select,
-                         "How nee and mis choose among several lights: power (by emitted flux, default) or uniform")
+                         "How nee and mis choose among several lights: power (by emitted flux; default, or the pbrt-v4 "
+                         "file's) or uniform")
       ->check(CLI::IsMember({"power", "uniform"}));
   render_cmd->add_option("--stats", ro.stats, "Write render statistics as JSON to this file");
   render_cmd->add_flag("--quiet", ro.quiet, "No progress line");
@@ -307,7 +321,7 @@ int main(int argc, char** argv) {
 
   samples_options sop;
   CLI::App* samples_cmd = app.add_subcommand("samples", "Write samples of one light's strategy as CSV");
-  samples_cmd->add_option("scene", sop.scene, "Scene file (JSON)")->required();
+  samples_cmd->add_option("scene", sop.scene, "Scene file (JSON, or pbrt-v4: .pbrt, .pbrt.gz)")->required();
   samples_cmd->add_option("--light", sop.light, "Index of the light among the scene's lights, in file order")->required();
   samples_cmd->add_option("--from", sop.from, "The receiving point X,Y,Z")->required();
   samples_cmd->add_option("--normal", sop.normal, "The receiving surface's normal X,Y,Z")->required();

@@ -43,12 +43,22 @@ int run_samples(const samples_options& opt) {
   const ellipse_map map = opt.ellipse_map == "polar" ? ellipse_map::polar : ellipse_map::parallel;
   if (!opt.output.empty()) check_writable(opt.output, false);
   const loaded_scene ls = load_scene(opt.scene, strategy, map);
-  const std::size_t count = ls.world.emitters.size();
+  // A pbrt-v4 file numbers its lights in file order, a two-sided one with
+  // an entry per side: the side that faces the point is sampled.
+  const bool by_file = !ls.file_lights.empty();
+  const std::size_t count = by_file ? ls.file_lights.size() : ls.world.emitters.size();
   if (opt.light < 0 || static_cast<std::size_t>(opt.light) >= count)
     throw input_error("--light: the scene " + opt.scene + " has " + std::to_string(count) + " light" +
                       (count == 1 ? "" : "s") + " (indices 0.." + std::to_string(count == 0 ? 0 : count - 1) +
                       "), got " + std::to_string(opt.light));
-  const light& l = ls.world.lights[ls.world.emitters[static_cast<std::size_t>(opt.light)].light];
+  std::size_t entry = static_cast<std::size_t>(opt.light);
+  if (by_file) {
+    const std::vector<std::uint32_t>& sides = ls.file_lights[entry];
+    entry = sides.front();
+    for (const std::uint32_t e : sides)
+      if (faces(ls.world.lights[ls.world.emitters[e].light], o)) entry = e;
+  }
+  const light& l = ls.world.lights[ls.world.emitters[entry].light];
 
   std::string csv = "u1,u2,dx,dy,dz,px,py,pz,pdf\n";
   csv.reserve(static_cast<std::size_t>(opt.n) * 96);

@@ -1,5 +1,8 @@
 #include "scene_loader.hpp"
 
+#include "pbrt/builder.hpp"
+#include "texture_io.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -374,8 +377,47 @@ std::optional<light_sampling> parse_light_sampling_flag(const std::string& value
   throw input_error("--light-sampling: unknown strategy '" + value + "' (expected " + strategy_names + ")");
 }
 
+bool is_pbrt_file(const std::string& path) { return path.ends_with(".pbrt") || path.ends_with(".pbrt.gz"); }
+
+namespace {
+
+loaded_scene load_pbrt_scene(const std::string& path, std::optional<light_sampling> override_strategy) {
+  pbrt::build_options opt;
+  opt.strategy = override_strategy;
+  opt.decode_image = decode_texture_image;
+  pbrt::built_scene b;
+  try {
+    b = pbrt::load_pbrt_file(path, opt);
+  } catch (const pbrt::parse_error& e) {
+    throw input_error(e.what());
+  }
+  loaded_scene out;
+  std::string name = std::filesystem::path(path).filename().string();
+  name = name.substr(0, name.find('.'));
+  out.name = name;
+  out.world = std::move(b.world);
+  out.cam.width = b.film.width;
+  out.cam.height = b.film.height;
+  out.make_camera = [cfw = b.camera_from_world, pp = b.perspective](int w, int h) {
+    return pbrt::perspective_camera(cfw, pp, w, h);
+  };
+  out.spp = b.spp;
+  out.max_depth = b.max_depth;
+  out.sampler = b.sampler;
+  out.light_select = b.light_select;
+  out.output = b.film.filename;
+  out.file_lights = std::move(b.file_lights);
+  out.filter = b.filter.kind;
+  out.filter_radius = b.filter.radius;
+  out.filter_sigma = b.filter.sigma;
+  return out;
+}
+
+}  // namespace
+
 loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy, ellipse_map map,
                         const auto_params& ap, bool auto_pilot, std::span<const auto_receiver> auto_receivers) {
+  if (is_pbrt_file(path)) return load_pbrt_scene(path, override_strategy);
   const context ctx{path};
   const reader rd{ctx};
   std::ifstream in(path, std::ios::binary);
@@ -461,6 +503,9 @@ loaded_scene load_scene(const std::string& path, std::optional<light_sampling> o
       grow(b.xf.to_world({(c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z}));
     }
   out.world.ray_epsilon = 2e-6f * extent;
+  out.make_camera = [c = out.cam](int, int) {
+    return camera(c.lookfrom, c.lookat, c.vup, c.vfov, static_cast<float>(c.width) / static_cast<float>(c.height));
+  };
   return out;
 }
 

@@ -1,7 +1,9 @@
 #pragma once
-// Reads a scene file (the contract of scenes/FORMAT.md) into an mcrt::scene.
+// Reads a scene file (the contract of scenes/FORMAT.md, or a pbrt-v4 file:
+// the contract pbrt-scenes.md, src/pbrt/builder.hpp) into an mcrt::scene.
 // Every violation of the contract throws input_error with one line naming
 // the file, the place in it and what is wrong.
+#include <functional>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -31,8 +33,24 @@ struct camera_desc {
 struct loaded_scene {
   std::string name;  // file name without directory and extension
   scene world;
-  camera_desc cam;
+  camera_desc cam;  // the JSON format's camera (its width and height also for pbrt-v4 files)
+  // The camera for an image of width x height: the JSON format's keeps the
+  // scene's aspect ratio (another resolution resamples the same view);
+  // pbrt-v4's screen window follows the image's aspect ratio, as in pbrt.
+  std::function<camera(int width, int height)> make_camera;
   int spp = 100, max_depth = 50;
+  // What a pbrt-v4 file asks for where the command line is silent: the
+  // sample generator, the light selection and the output file (its Film's
+  // filename); empty for JSON scenes.
+  std::string sampler, light_select, output;
+  // pbrt-v4 files: each light in file order (a mesh's triangles in face
+  // order) as its entries in world.emitters (two for a two-sided light).
+  std::vector<std::vector<std::uint32_t>> file_lights;
+  // pbrt-v4 files: the pixel filter (kind box, gaussian or triangle; radius;
+  // sigma); JSON scenes: box of radius 0.5.
+  std::string filter = "box";
+  vec2 filter_radius{0.5f, 0.5f};
+  float filter_sigma = 0.5f;
   int auto_lights = 0;  // lights sampled by `auto`
   // Time spent making those lights' samplers (seconds): `mcrt render` counts
   // it in the image's time, as it does the noise pilot.
@@ -63,6 +81,9 @@ std::optional<light_sampling> parse_light_sampling_flag(const std::string& value
 // auto_receivers: the surfaces the noise pilot's pixels see; where given, a
 // light sampled by `auto` whose choice does not pay for its cost there
 // takes its cheapest strategy everywhere (auto_sampler::table_gain).
+// Whether a path names a pbrt-v4 file (.pbrt, .pbrt.gz).
+bool is_pbrt_file(const std::string& path);
+
 loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy = std::nullopt,
                         ellipse_map map = ellipse_map::parallel, const auto_params& ap = {}, bool auto_pilot = false,
                         std::span<const auto_receiver> auto_receivers = {});

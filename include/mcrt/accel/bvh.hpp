@@ -21,33 +21,9 @@
 
 #include "mcrt/core/math.hpp"
 #include "mcrt/core/ray.hpp"
+#include "mcrt/geometry/aabb.hpp"
 
 namespace mcrt {
-
-// An axis-aligned box; empty when lo > hi.
-struct aabb {
-  vec3 lo{infinity}, hi{-infinity};
-
-  void grow(const vec3& p) {
-    lo = glm::min(lo, p);
-    hi = glm::max(hi, p);
-  }
-  void grow(const aabb& b) {
-    lo = glm::min(lo, b.lo);
-    hi = glm::max(hi, b.hi);
-  }
-  bool empty() const { return !(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z); }
-  vec3 centroid() const { return 0.5f * (lo + hi); }
-  float surface_area() const {
-    if (empty()) return 0.0f;
-    const vec3 d = hi - lo;
-    return 2.0f * (d.x * d.y + d.y * d.z + d.z * d.x);
-  }
-  int longest_axis() const {
-    const vec3 d = hi - lo;
-    return d.x > d.y ? (d.x > d.z ? 0 : 2) : (d.y > d.z ? 1 : 2);
-  }
-};
 
 class bvh {
  public:
@@ -81,6 +57,13 @@ class bvh {
   const std::vector<node>& nodes() const { return nodes_; }
   // The primitives in the order the leaves reference them.
   const std::vector<std::uint32_t>& order() const { return order_; }
+
+  // For a caller that has stored its primitives in order() (leaf by leaf,
+  // so that a leaf's primitives are adjacent in memory): from then on the
+  // traversal names a primitive by its place in that order.
+  void renumber_in_order() {
+    for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = static_cast<std::uint32_t>(i);
+  }
 
   // The closest hit in (tmin, tmax): hit(i, tmin, tmax) tests primitive i
   // and returns its hit's t, or a value >= tmax (infinity) for none; tmax

@@ -3,6 +3,7 @@
 // Next Week", sec. 7-8: the tall box of the Cornell scenes). Intersected as
 // one shape with the slab test (Kay & Kajiya 1986) in its own frame, not as
 // six rectangles.
+#include "mcrt/geometry/aabb.hpp"
 #include "mcrt/geometry/transform.hpp"
 
 namespace mcrt {
@@ -11,6 +12,13 @@ struct box {
   vec3 lo{0.0f}, hi{1.0f};
   rigid_y xf{};
   bool flip = false;  // front side inside instead of outside
+
+  // The box of the eight corners in the world.
+  aabb bounds() const {
+    aabb b;
+    for (int c = 0; c < 8; ++c) b.grow(xf.to_world({(c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z}));
+    return b;
+  }
 
   bool intersect(const ray& world_ray, float tmin, float tmax, float& t) const {
     const ray r = xf.to_local(world_ray);

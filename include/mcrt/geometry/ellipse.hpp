@@ -2,6 +2,7 @@
 // A planar ellipse given by its centre and two orthogonal semi-axes; equal
 // lengths make a disk.
 #include "mcrt/core/ray.hpp"
+#include "mcrt/geometry/aabb.hpp"
 #include "mcrt/geometry/hit_record.hpp"
 
 namespace mcrt {
@@ -32,6 +33,13 @@ struct ellipse {
   }
 
   bool faces(const vec3& o) const { return glm::dot(o - center, n) > 0.0f; }
+
+  // The tight box: along axis i the ellipse reaches sqrt(a1_i^2 + a2_i^2)
+  // from its centre.
+  aabb bounds() const {
+    const vec3 reach = glm::sqrt(a1 * a1 + a2 * a2);
+    return {center - reach, center + reach};
+  }
 
   bool intersect(const ray& r, float tmin, float tmax, float& t) const {
     const float denom = glm::dot(n, r.d);

@@ -20,9 +20,24 @@ struct hit_record {
   // surface it leaves (Pharr et al., "Physically Based Rendering", 4th ed.,
   // sec. 6.8.6). Rays also start past the scene's t_min (scene::ray_epsilon).
   float offset = 0.0f;
+  // Where the shape has them (triangles of meshes): the unit shading normal
+  // (interpolated vertex normals, on the side of n), the texture coordinates
+  // and the surface's tangent dp/du. ns is zero where the shape has no
+  // shading normal: shading_normal() is then n.
+  vec3 ns{0.0f};
+  vec2 uv{0.0f};
+  vec3 dpdu{0.0f};
 
-  // The unit normal on the side the ray came from (shading normal).
+  // The unit normal on the side the ray came from (geometric normal).
   vec3 facing_normal() const { return front_face ? n : -n; }
+  // The unit shading normal on the front side (n where there is none).
+  vec3 shading_normal() const { return ns == vec3(0.0f) ? n : ns; }
+  // The unit shading normal on the side a ray along d came from (the
+  // facing normal where the shape has no shading normal).
+  vec3 facing_shading_normal(const vec3& d) const {
+    if (ns == vec3(0.0f)) return facing_normal();
+    return glm::dot(d, ns) < 0.0f ? ns : -ns;
+  }
 
   // The origin of a ray leaving p along dir: p moved off the surface by
   // `offset` to the side dir points into (pbrt-v4's OffsetRayOrigin).

@@ -4,6 +4,7 @@
 // yz_rect, are made by the factories at the end of this header; they are the
 // same shape, so every sampling strategy serves all of them.
 #include "mcrt/core/ray.hpp"
+#include "mcrt/geometry/aabb.hpp"
 #include "mcrt/geometry/hit_record.hpp"
 
 namespace mcrt {
@@ -35,6 +36,13 @@ struct rect {
   }
 
   vec3 center() const { return corner + 0.5f * (e1 + e2); }
+
+  // The box of the four corners.
+  aabb bounds() const {
+    aabb b;
+    for (const vec3& p : {corner, corner + e1, corner + e2, corner + e1 + e2}) b.grow(p);
+    return b;
+  }
 
   // Is o strictly on the front side of the rectangle's plane?
   bool faces(const vec3& o) const { return glm::dot(o - corner, n) > 0.0f; }

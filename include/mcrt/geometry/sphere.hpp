@@ -1,6 +1,7 @@
 #pragma once
 // Sphere (Shirley, "Ray Tracing in One Weekend", sec. 5-6).
 #include "mcrt/core/ray.hpp"
+#include "mcrt/geometry/aabb.hpp"
 #include "mcrt/geometry/hit_record.hpp"
 
 namespace mcrt {
@@ -9,6 +10,8 @@ struct sphere {
   vec3 center{0.0f};
   float radius = 1.0f;
   bool flip = false;  // front side inside instead of outside
+
+  aabb bounds() const { return {center - vec3(radius), center + vec3(radius)}; }
 
   bool intersect(const ray& r, float tmin, float tmax, float& t) const {
     // Half-b form; the discriminant is computed from the distance of the ray

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "mcrt/core/ray.hpp"
+#include "mcrt/geometry/aabb.hpp"
 #include "mcrt/geometry/hit_record.hpp"
 
 namespace mcrt {
@@ -147,6 +148,12 @@ struct triangle {
     return ng;
   }
 
+  aabb bounds() const {
+    aabb b;
+    for (int k = 0; k < 3; ++k) b.grow(vertex(k));
+    return b;
+  }
+
   float area() const { return 0.5f * glm::length(glm::cross(vertex(1) - vertex(0), vertex(2) - vertex(0))); }
 
   bool intersect(const ray& r, float tmin, float tmax, float& t) const {
@@ -156,23 +163,54 @@ struct triangle {
     return true;
   }
 
-  // The hit record of a hit at t found by intersect(): the point
-  // interpolated from the vertices, its rounding bound as the offset.
-  void surface(const ray& r, float t, hit_record& rec) const {
-    const vec3 p0 = vertex(0), p1 = vertex(1), p2 = vertex(2);
-    rec.t = t;
+  // The hit record of the hit h: the point interpolated from the vertices,
+  // its rounding bound as the offset; the shading normal interpolated from
+  // the vertex normals, the texture coordinates (pbrt-v4's (0,0), (1,0),
+  // (1,1) where the mesh has none) and dp/du (pbrt-v4's Triangle::
+  // InteractionFromIntersection).
+  void surface_at(const ray& r, const triangle_hit& h, hit_record& rec) const {
+    const std::size_t i = 3 * std::size_t(index);
+    const std::uint32_t v0 = mesh->indices[i], v1 = mesh->indices[i + 1], v2 = mesh->indices[i + 2];
+    const vec3 p0 = mesh->p[v0], p1 = mesh->p[v1], p2 = mesh->p[v2];
+    rec.t = h.t;
     rec.n = normal();
-    // The same computation as intersect()'s, so it gives the same hit.
-    if (const std::optional<triangle_hit> h = intersect_triangle(r, infinity, p0, p1, p2)) {
-      rec.p = h->b0 * p0 + h->b1 * p1 + h->b2 * p2;
-      // PBRT 4th ed., eq. 6.28: gamma(7) (|b0 p0| + |b1 p1| + |b2 p2|).
-      const vec3 error = rounding_gamma(7) * (glm::abs(h->b0 * p0) + glm::abs(h->b1 * p1) + glm::abs(h->b2 * p2));
-      rec.offset = glm::dot(glm::abs(rec.n), error);
-    } else {
-      rec.p = r.at(t);
-      rec.offset = 0.0f;
-    }
+    rec.p = h.b0 * p0 + h.b1 * p1 + h.b2 * p2;
+    // PBRT 4th ed., eq. 6.28: gamma(7) (|b0 p0| + |b1 p1| + |b2 p2|).
+    const vec3 error = rounding_gamma(7) * (glm::abs(h.b0 * p0) + glm::abs(h.b1 * p1) + glm::abs(h.b2 * p2));
+    rec.offset = glm::dot(glm::abs(rec.n), error);
     rec.front_face = glm::dot(r.d, rec.n) < 0.0f;
+    vec2 uv0{0.0f, 0.0f}, uv1{1.0f, 0.0f}, uv2{1.0f, 1.0f};
+    if (!mesh->uv.empty()) uv0 = mesh->uv[v0], uv1 = mesh->uv[v1], uv2 = mesh->uv[v2];
+    rec.uv = h.b0 * uv0 + h.b1 * uv1 + h.b2 * uv2;
+    const vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
+    const vec3 dp02 = p0 - p2, dp12 = p1 - p2;
+    const float det = detail::difference_of_products(duv02.x, duv12.y, duv02.y, duv12.x);
+    // A degenerate uv mapping gives no tangent: the shading frame then takes
+    // any basis about the normal.
+    rec.dpdu = std::abs(det) < 1e-9f ? vec3(0.0f) : (duv12.y * dp02 - duv02.y * dp12) / det;
+    if (!mesh->n.empty()) {
+      const vec3 ns = h.b0 * mesh->n[v0] + h.b1 * mesh->n[v1] + h.b2 * mesh->n[v2];
+      const float len2 = glm::dot(ns, ns);
+      rec.ns = len2 > 0.0f ? ns / std::sqrt(len2) : rec.n;
+    } else {
+      rec.ns = vec3(0.0f);
+    }
+  }
+
+  // The hit record of a hit at t found by intersect() (recomputes the
+  // intersection for its barycentric coordinates; the scene's accelerator
+  // keeps them from its own test instead).
+  void surface(const ray& r, float t, hit_record& rec) const {
+    if (const std::optional<triangle_hit> h = intersect_triangle(r, infinity, vertex(0), vertex(1), vertex(2))) {
+      surface_at(r, *h, rec);
+      rec.t = t;
+    } else {
+      rec.t = t;
+      rec.p = r.at(t);
+      rec.n = normal();
+      rec.offset = 0.0f;
+      rec.front_face = glm::dot(r.d, rec.n) < 0.0f;
+    }
   }
 
   bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {

@@ -2,11 +2,14 @@
 // The materials of Shirley's books ("In One Weekend" sec. 8-10, "The Rest of
 // Your Life" sec. 10), as plain value types dispatched statically through
 // std::variant: a scene stores only the materials it names.
+#include <cstdint>
 #include <variant>
 
 #include "mcrt/core/ray.hpp"
 #include "mcrt/core/rng.hpp"
 #include "mcrt/geometry/hit_record.hpp"
+#include "mcrt/materials/microfacet_materials.hpp"
+#include "mcrt/materials/texture.hpp"
 #include "mcrt/sampling/warp.hpp"
 
 namespace mcrt {
@@ -27,12 +30,59 @@ struct dielectric {
   float ior = 1.5f;
 };
 
-// Emits `emit` from its front side; scatters nothing.
-struct diffuse_light {
-  color emit{1.0f};
+// A diffuse reflector whose albedo is a texture (pbrt-v4's "diffuse"
+// material with a textured reflectance): sampled and lit as a lambertian
+// with the albedo the texture has at the hit's (u, v).
+struct textured_diffuse {
+  texture reflectance;
 };
 
-using material = std::variant<lambertian, metal, dielectric, diffuse_light>;
+// Emits `emit` from its front side (from both sides when `twosided`, pbrt-v4's
+// area light "twosided"). A light of Shirley's scenes scatters nothing;
+// a light of a pbrt-v4 scene also reflects with its surface's material, the
+// material with index `surface` (pbrt-v4's emitting shapes keep their
+// material), where that is not no_surface.
+struct diffuse_light {
+  static constexpr std::uint32_t no_surface = 0xffffffffu;
+  color emit{1.0f};
+  bool twosided = false;
+  std::uint32_t surface = no_surface;
+};
+
+// pbrt-v4's conductor and dielectric (microfacet_materials.hpp) come last:
+// Shirley's scenes pay nothing for them.
+using material =
+    std::variant<lambertian, metal, dielectric, diffuse_light, textured_diffuse, conductor_material, dielectric_material>;
+
+// The BSDF of a material that has one (pbrt-v4's conductor and dielectric)
+// at a hit, passed to f; false for the others (Shirley's materials,
+// diffuse ones and lights).
+template <class F>
+inline bool with_bsdf(const material& m, const hit_record& rec, F&& f) {
+  if (const auto* c = std::get_if<conductor_material>(&m)) {
+    f(c->at(rec));
+    return true;
+  }
+  if (const auto* d = std::get_if<dielectric_material>(&m)) {
+    f(d->at(rec));
+    return true;
+  }
+  return false;
+}
+
+// The albedo of a diffuse material at a hit (lambertian or textured);
+// false for every other material.
+inline bool diffuse_albedo(const material& m, const hit_record& rec, color& albedo) {
+  if (const auto* lam = std::get_if<lambertian>(&m)) {
+    albedo = lam->albedo;
+    return true;
+  }
+  if (const auto* td = std::get_if<textured_diffuse>(&m)) {
+    albedo = td->reflectance.eval(rec.uv);
+    return true;
+  }
+  return false;
+}
 
 // What a specular material does with an incoming ray.
 struct specular_scatter {
@@ -41,7 +91,7 @@ struct specular_scatter {
 };
 
 inline color emitted(const material& m, const hit_record& rec) {
-  if (const auto* l = std::get_if<diffuse_light>(&m)) return rec.front_face ? l->emit : color(0.0f);
+  if (const auto* l = std::get_if<diffuse_light>(&m)) return rec.front_face || l->twosided ? l->emit : color(0.0f);
   return color(0.0f);
 }
 

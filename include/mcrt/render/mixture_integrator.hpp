@@ -28,18 +28,23 @@ struct mixture_integrator {
         radiance += throughput * sc.background;
         break;
       }
-      const material& m = sc.materials[rec.material];
-      if (const auto* l = std::get_if<diffuse_light>(&m)) {
-        if (rec.front_face) radiance += throughput * l->emit;
-        break;
+      const material* mp = &sc.materials[rec.material];
+      if (const auto* l = std::get_if<diffuse_light>(mp)) {
+        if (rec.front_face || l->twosided) radiance += throughput * l->emit;
+        // A light of Shirley's scenes ends the path; one of a pbrt-v4 scene
+        // reflects with its surface's material.
+        if (l->surface == diffuse_light::no_surface) break;
+        mp = &sc.materials[l->surface];
       }
+      const material& m = *mp;
       if (depth == set.max_depth) break;
       const int b = layout::bounce(depth);
       if (depth >= set.rr_depth && !survive_roulette(throughput, [&] { return ps.get1d(b + layout::roulette); }))
         break;
 
-      if (const auto* lam = std::get_if<lambertian>(&m)) {
-        const vec3 n = rec.facing_normal();
+      color albedo;
+      if (diffuse_albedo(m, rec, albedo)) {
+        const vec3 n = rec.facing_shading_normal(r.d);
         const vec3 origin = rec.spawn_origin(n);  // the sampled directions leave on the facing side
         const cosine_pdf cos_pdf(n);
         const light_pdf<light> lights(sc.lights, origin, n);
@@ -53,8 +58,55 @@ struct mixture_integrator {
         const float cos_theta = glm::dot(dir, n);
         // Below the surface the scattering pdf is 0: the path carries nothing more.
         if (!(cos_theta > 0.0f) || !(p > 0.0f)) break;
-        throughput *= lam->albedo * (cos_theta * inv_pi / p);
+        throughput *= albedo * (cos_theta * inv_pi / p);
         r = {origin, dir};
+        continue;
+      }
+
+      // pbrt-v4's conductor and dielectric: the mixture of the lights' pdf
+      // and the BSDF's own (50/50), or the BSDF alone where it is a delta.
+      bool scattered = false, absorbed = false;
+      with_bsdf(m, rec, [&](const auto& bsdf) {
+        scattered = true;
+        const shading_frame fr = shading_frame::from_normal_tangent(rec.shading_normal(), rec.dpdu);
+        const vec3 wo = fr.to_local(-glm::normalize(r.d));
+        const vec3 n = wo.z < 0.0f ? -fr.z : fr.z;
+        const light_pdf<light> lights(sc.lights, rec.p, n);
+        const float u_select = ps.get1d(b + layout::light_choice);
+        vec3 wi_local;
+        color f;
+        float p;
+        if (bsdf.is_delta() || lights.empty() || u_select < 0.5f) {
+          bsdf_sample bs;
+          if (!bsdf.sample(wo, ps.get1d(b + layout::material_choice), ps.get2d(b + layout::material), bs) ||
+              !(bs.pdf > 0.0f)) {
+            absorbed = true;
+            return;
+          }
+          wi_local = bs.wi;
+          f = bs.f;
+          p = bs.delta || lights.empty() ? bs.pdf : 0.5f * (bs.pdf + lights.value(fr.to_world(bs.wi)));
+        } else {
+          light_sample s;
+          const std::ptrdiff_t k = lights.generate(2.0f * u_select - 1.0f, ps.get2d(b + layout::light), s);
+          if (k < 0) {
+            absorbed = true;
+            return;
+          }
+          wi_local = fr.to_local(s.dir);
+          f = bsdf.eval(wo, wi_local);
+          p = 0.5f * (bsdf.pdf(wo, wi_local) + lights.value(s.dir, k, s.pdf));
+        }
+        if (f == color(0.0f) || !(p > 0.0f)) {
+          absorbed = true;
+          return;
+        }
+        const vec3 wi = glm::normalize(fr.to_world(wi_local));
+        throughput *= f * (std::abs(wi_local.z) / p);
+        r = {rec.spawn_origin(wi), wi};
+      });
+      if (scattered) {
+        if (absorbed) break;
         continue;
       }
 

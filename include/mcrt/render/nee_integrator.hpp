@@ -60,6 +60,33 @@ color sample_direct_light(const Scene& sc, const vec3& p, const vec3& n, const c
   return le * albedo * (cos_theta * inv_pi * w / p_light);
 }
 
+// One light sample from a point with a BSDF (pbrt-v4's conductor and
+// dielectric, not delta): the same technique as sample_direct_light, with
+// the BSDF's value f(wo, wi) |cos theta_i| in the shading frame fr and its
+// own pdf in the weight; directions on either side of the surface (a rough
+// dielectric transmits). The shadow ray leaves rec's point on the side of
+// the direction (hit_record::spawn_origin).
+template <class Weights, class Scene, class P, class Bsdf>
+color sample_direct_light_bsdf(const Scene& sc, const hit_record& rec, const shading_frame& fr, const vec3& wo,
+                               const Bsdf& bsdf, const light_selection& sel, P& ps, int b, const path_settings& set) {
+  if (sel.empty()) return color(0.0f);
+  float prob = 0.0f;
+  const std::ptrdiff_t k = sel.pick(sel.needs_choice() ? ps.get1d(b + layout::light_choice) : 0.0f, prob);
+  if (k < 0) return color(0.0f);
+  light_sample s;
+  if (!sample(sc.lights[static_cast<std::size_t>(k)], sel.point(), sel.normal(), ps.get2d(b + layout::light), s))
+    return color(0.0f);
+  const vec3 wi = fr.to_local(s.dir);
+  const color f = bsdf.eval(wo, wi) * std::abs(wi.z);
+  if (f == color(0.0f)) return color(0.0f);
+  const float p_light = sel.pdf(s.dir, k, s.pdf);
+  if (!(p_light > 0.0f) || !std::isfinite(p_light)) return color(0.0f);
+  const color le = shadow_ray_radiance(sc, rec.spawn_origin(s.dir), s.dir);
+  if (le == color(0.0f)) return color(0.0f);
+  const float w = Weights::light(set, p_light, bsdf.pdf(wo, wi));
+  return le * f * (w / p_light);
+}
+
 template <class Weights>
 struct next_event_integrator {
   template <class Scene, class P>
@@ -77,23 +104,28 @@ struct next_event_integrator {
         radiance += throughput * sc.background;
         break;
       }
-      const material& m = sc.materials[rec.material];
-      if (const auto* l = std::get_if<diffuse_light>(&m)) {
-        if (rec.front_face) {
+      const material* mp = &sc.materials[rec.material];
+      if (const auto* l = std::get_if<diffuse_light>(mp)) {
+        if (rec.front_face || l->twosided) {
           const float w = after_diffuse ? Weights::material(set, prev_p_material, prev_sel.pdf(r.d)) : 1.0f;
           radiance += throughput * l->emit * w;
         }
-        break;
+        // A light of Shirley's scenes ends the path; one of a pbrt-v4 scene
+        // reflects with its surface's material.
+        if (l->surface == diffuse_light::no_surface) break;
+        mp = &sc.materials[l->surface];
       }
+      const material& m = *mp;
       if (depth == set.max_depth) break;
       const int b = layout::bounce(depth);
 
-      if (const auto* lam = std::get_if<lambertian>(&m)) {
-        const vec3 n = rec.facing_normal();
+      color albedo;
+      if (diffuse_albedo(m, rec, albedo)) {
+        const vec3 n = rec.facing_shading_normal(r.d);
         // Light samples and the continuation leave on the facing side.
         const vec3 p = rec.spawn_origin(n);
         const light_selection sel(sc, p, n, set.choose);
-        radiance += throughput * sample_direct_light<Weights>(sc, p, n, lam->albedo, sel, ps, b, set);
+        radiance += throughput * sample_direct_light<Weights>(sc, p, n, albedo, sel, ps, b, set);
         if (depth >= set.rr_depth && !survive_roulette(throughput, [&] { return ps.get1d(b + layout::roulette); }))
           break;
         // The last scattering event of a plain next-event estimator: the
@@ -105,11 +137,46 @@ struct next_event_integrator {
         const float cos_theta = glm::dot(dir, n);
         if (!(cos_theta > 0.0f)) break;
         // f cos / p = (albedo / pi) cos / (cos / pi)
-        throughput *= lam->albedo;
+        throughput *= albedo;
         after_diffuse = true;
         prev_sel = sel;
         prev_p_material = cos_theta * inv_pi;
         r = {p, dir};
+        continue;
+      }
+
+      // pbrt-v4's conductor and dielectric: a light sample where the BSDF is
+      // not a delta, then the BSDF's own sample.
+      bool scattered = false, absorbed = false;
+      with_bsdf(m, rec, [&](const auto& bsdf) {
+        scattered = true;
+        const shading_frame fr = shading_frame::from_normal_tangent(rec.shading_normal(), rec.dpdu);
+        const vec3 wo = fr.to_local(-glm::normalize(r.d));
+        // The light technique's density with the shading normal on wo's side.
+        const light_selection sel(sc, rec.p, wo.z < 0.0f ? -fr.z : fr.z, set.choose);
+        if (!bsdf.is_delta())
+          radiance += throughput * sample_direct_light_bsdf<Weights>(sc, rec, fr, wo, bsdf, sel, ps, b, set);
+        if (depth >= set.rr_depth && !survive_roulette(throughput, [&] { return ps.get1d(b + layout::roulette); })) {
+          absorbed = true;
+          return;
+        }
+        bsdf_sample bs;
+        if (!bsdf.sample(wo, ps.get1d(b + layout::material_choice), ps.get2d(b + layout::material), bs) ||
+            !(bs.pdf > 0.0f) || bs.f == color(0.0f)) {
+          absorbed = true;
+          return;
+        }
+        const vec3 wi = glm::normalize(fr.to_world(bs.wi));
+        throughput *= bs.f * (std::abs(bs.wi.z) / bs.pdf);
+        after_diffuse = !bs.delta;
+        if (!bs.delta) {
+          prev_sel = sel;
+          prev_p_material = bs.pdf;
+        }
+        r = {rec.spawn_origin(wi), wi};
+      });
+      if (scattered) {
+        if (absorbed) break;
         continue;
       }
 

@@ -4,7 +4,10 @@
 // pixel's numbers depend only on (seed, pixel, sample index, dimension), so
 // an image is bit-identical whatever the thread count. Each camera sample
 // is a ray through the point of the pixel the sampler gives (dimensions 0
-// and 1), and the pixel's value is the mean of its samples (box filter).
+// and 1), drawn from the pixel filter (filter importance sampling, as
+// pbrt-v4: render/pixel_filter.hpp), and the pixel's value is the mean of
+// its samples, each of weight 1. The default filter, the box of radius 0.5,
+// is a point uniform in the pixel.
 //
 // render_with<Integrator, Sampler> is the statically dispatched core; render()
 // picks the pair named in render_settings at run time, so a program pays only
@@ -22,6 +25,7 @@
 #include "mcrt/render/camera.hpp"
 #include "mcrt/render/image.hpp"
 #include "mcrt/render/path_tracer.hpp"
+#include "mcrt/render/pixel_filter.hpp"
 #include "mcrt/samplers/samplers.hpp"
 
 namespace mcrt {
@@ -37,6 +41,7 @@ struct render_settings {
   sampler_kind sampler = sampler_kind::sobol;  // the most efficient in the study (docs/results.md)
   light_choice choose = light_choice::power;       // nee, mis (path_settings)
   mis_heuristic heuristic = mis_heuristic::power;  // mis (path_settings)
+  pixel_filter filter;  // the box of radius 0.5: each pixel's samples uniform in it
 
   path_settings path() const { return {max_depth, rr_depth, choose, heuristic}; }
 };
@@ -57,18 +62,21 @@ inline ray pixel_ray(const camera& cam, int x, int y, vec2 j, float inv_w, float
   return cam.generate((static_cast<float>(x) + j.x) * inv_w, (static_cast<float>(y) + j.y) * inv_h);
 }
 
-// The camera ray of one sample of pixel (x, y): through the point of the
-// pixel the sampler gives (dimensions 0 and 1).
+// The camera ray of one sample of pixel (x, y): through the point the
+// filter draws with the sampler's numbers (dimensions 0 and 1); with the
+// default box of radius 0.5, the point of the pixel they give.
 template <class PixelSampler>
-ray camera_ray(const camera& cam, PixelSampler& ps, int x, int y, float inv_w, float inv_h) {
-  return pixel_ray(cam, x, y, ps.pixel(), inv_w, inv_h);
+ray camera_ray(const camera& cam, PixelSampler& ps, int x, int y, float inv_w, float inv_h,
+               const pixel_filter& filter = {}) {
+  const vec2 p = filter.film_point(x, y, ps.pixel());
+  return cam.generate(p.x * inv_w, p.y * inv_h);
 }
 
 // One camera sample of pixel (x, y): its camera ray and the radiance along it.
 template <class Integrator, class Scene, class PixelSampler>
 color camera_sample(const Scene& sc, const camera& cam, PixelSampler& ps, int x, int y, float inv_w, float inv_h,
-                    const path_settings& set) {
-  return Integrator::li(sc, camera_ray(cam, ps, x, y, inv_w, inv_h), ps, set);
+                    const path_settings& set, const pixel_filter& filter = {}) {
+  return Integrator::li(sc, camera_ray(cam, ps, x, y, inv_w, inv_h, filter), ps, set);
 }
 
 template <class Integrator, class Scene, class Sampler>
@@ -80,7 +88,7 @@ color render_pixel(const Scene& sc, const camera& cam, const render_settings& rs
   glm::dvec3 sum(0.0);
   for (int s = 0; s < rs.spp; ++s) {
     ps.start_sample(s);
-    const color c = camera_sample<Integrator>(sc, cam, ps, x, y, inv_w, inv_h, set);
+    const color c = camera_sample<Integrator>(sc, cam, ps, x, y, inv_w, inv_h, set, rs.filter);
     if (all_finite(c))
       sum += glm::dvec3(c);
     else

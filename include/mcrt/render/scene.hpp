@@ -2,9 +2,17 @@
 // A scene: shapes stored by type (one std::vector per shape type, so a ray
 // pays only for the types a scene has, with no per-object dispatch), the
 // materials they reference, and the lights sampled at each diffuse bounce.
+// A scene of more than a handful of shapes (meshes) is intersected through a
+// bounding volume hierarchy over all of them (accel/bvh.hpp), built by
+// build_accelerator(); a small one, such as the Cornell boxes, keeps testing
+// its lists, which is faster there (bench/bench_scene_accel.cpp).
+#include <array>
 #include <cstdint>
 #include <tuple>
+#include <utility>
 #include <vector>
+
+#include "mcrt/accel/bvh.hpp"
 
 #include "mcrt/geometry/axis_rect_set.hpp"
 #include "mcrt/geometry/box.hpp"
@@ -86,6 +94,56 @@ struct basic_scene {
     return k;
   }
 
+  // Scenes with at most this many shapes in their lists keep testing the
+  // lists: below it a ray's tests of every shape cost less than a traversal
+  // (bench/bench_scene_accel.cpp measures the crossover).
+  static constexpr std::size_t list_limit = 16;
+
+  // Builds the hierarchy over every shape of the lists (not the
+  // axis-aligned set, which is intersected as a set) when they hold more
+  // than `limit`; from then on hit() traverses it. Shapes added later send
+  // hit() back to the lists until it is called again.
+  void build_accelerator(std::size_t limit = list_limit) {
+    accel_active_ = false;
+    prims_.clear();
+    tri_verts_.clear();
+    if (list_object_count() <= limit) return;
+    std::vector<aabb> bounds;
+    std::vector<prim_ref> refs;
+    bounds.reserve(list_object_count());
+    refs.reserve(list_object_count());
+    [&]<std::size_t... I>(std::index_sequence<I...>) {
+      (
+          [&] {
+            const auto& v = std::get<I>(objects);
+            for (std::size_t j = 0; j < v.size(); ++j) {
+              bounds.push_back(v[j].shape.bounds());
+              refs.push_back({static_cast<std::uint32_t>(I), static_cast<std::uint32_t>(j)});
+            }
+          }(),
+          ...);
+    }(std::index_sequence_for<Shapes...>{});
+    accel_ = bvh(bounds);
+    // The shapes in the leaves' order, a triangle's vertices beside its
+    // reference: a leaf's tests read adjacent memory.
+    prims_.resize(refs.size());
+    if constexpr (has_triangles) tri_verts_.resize(refs.size());
+    for (std::size_t k = 0; k < refs.size(); ++k) {
+      prims_[k] = refs[accel_.order()[k]];
+      if constexpr (has_triangles)
+        if (prims_[k].type == triangle_type) {
+          const triangle& t = std::get<triangle_type>(objects)[prims_[k].object].shape;
+          tri_verts_[k] = {t.vertex(0), t.vertex(1), t.vertex(2)};
+        }
+    }
+    accel_.renumber_in_order();
+    accel_active_ = true;
+  }
+
+  // Whether hit() traverses the hierarchy.
+  bool accelerated() const { return accel_active_; }
+  const bvh& accelerator() const { return accel_; }
+
   std::size_t object_count() const {
     return axis_rects.size() +
            std::apply([](const auto&... v) { return (v.size() + ... + std::size_t{0}); }, objects);
@@ -104,6 +162,7 @@ struct basic_scene {
         c.material = m->material;
       }
     }
+    if (accel_active_) return hit_accelerated(r, tmin, c, rec);
     std::apply([&](const auto&... v) { (closest_of(v, r, tmin, c), ...); }, objects);
     if (!c.shape) return false;
     c.fill(c.shape, r, c.t, rec);
@@ -116,25 +175,111 @@ struct basic_scene {
     if (m >= materials.size() || std::holds_alternative<diffuse_light>(materials[m])) ++unsampled_emitters;
   }
 
-  void add_geometry(const rect& r, std::uint32_t material_index) {
-    if (auto a = as_axis_rect(r, material_index))
-      axis_rects.add(*a);
-    else
-      std::get<std::vector<object<rect>>>(objects).push_back({r, material_index});
-  }
-  template <class Shape>
-  std::uint32_t add_geometry(const Shape& s, std::uint32_t material_index) {
-    auto& v = std::get<std::vector<object<Shape>>>(objects);
-    v.push_back({s, material_index});
-    return static_cast<std::uint32_t>(v.size() - 1);
-  }
-
   struct closest {
     float t;
     const void* shape = nullptr;
     void (*fill)(const void*, const ray&, float, hit_record&) = nullptr;
     std::uint32_t material = 0;
   };
+
+  template <class T, std::size_t I = 0>
+  static constexpr std::size_t type_index() {
+    if constexpr (I == sizeof...(Shapes))
+      return I;
+    else if constexpr (std::is_same_v<T, std::tuple_element_t<I, std::tuple<Shapes...>>>)
+      return I;
+    else
+      return type_index<T, I + 1>();
+  }
+  static constexpr std::size_t triangle_type = type_index<triangle>();
+  static constexpr bool has_triangles = triangle_type < sizeof...(Shapes);
+
+  // A shape of the hierarchy: its type's place in Shapes and its index in
+  // that type's list.
+  struct prim_ref {
+    std::uint32_t type = 0, object = 0;
+  };
+  bvh accel_;
+  std::vector<prim_ref> prims_;                 // in the hierarchy's order
+  std::vector<std::array<vec3, 3>> tri_verts_;  // a triangle's vertices, at its place in that order
+  bool accel_active_ = false;
+
+  std::size_t list_object_count() const {
+    return std::apply([](const auto&... v) { return (v.size() + ... + std::size_t{0}); }, objects);
+  }
+
+  // The shape ref's hit's t in (tmin, tmax), or infinity.
+  template <std::size_t I>
+  float intersect_ref(std::uint32_t object, const ray& r, float tmin, float tmax) const {
+    float t;
+    return std::get<I>(objects)[object].shape.intersect(r, tmin, tmax, t) ? t : infinity;
+  }
+  template <std::size_t... I>
+  float intersect_ref(const prim_ref& p, const ray& r, float tmin, float tmax, std::index_sequence<I...>) const {
+    float t = infinity;
+    ((p.type == I ? (void)(t = intersect_ref<I>(p.object, r, tmin, tmax)) : void()), ...);
+    return t;
+  }
+  template <std::size_t... I>
+  void fill_ref(const prim_ref& p, const ray& r, float t, hit_record& rec, std::index_sequence<I...>) const {
+    ((p.type == I ? (void)(fill_one<I>(p.object, r, t, rec)) : void()), ...);
+  }
+  template <std::size_t I>
+  void fill_one(std::uint32_t object, const ray& r, float t, hit_record& rec) const {
+    const auto& o = std::get<I>(objects)[object];
+    o.shape.surface(r, t, rec);
+    rec.material = o.material;
+  }
+
+  bool hit_accelerated(const ray& r, float tmin, closest& c, hit_record& rec) const {
+    triangle_hit tri{};  // the barycentrics of the closest triangle so far
+    float tmax = c.t;
+    const std::int64_t best = accel_.closest(r, tmin, tmax, [&](std::uint32_t slot, float t0, float t1) -> float {
+      const prim_ref& p = prims_[slot];
+      if constexpr (has_triangles)
+        if (p.type == triangle_type) {
+          const std::array<vec3, 3>& v = tri_verts_[slot];
+          const std::optional<triangle_hit> h = intersect_triangle(r, t1, v[0], v[1], v[2]);
+          if (!h || !(h->t > t0) || !(h->t < t1)) return infinity;
+          tri = *h;
+          return h->t;
+        }
+      return intersect_ref(p, r, t0, t1, std::index_sequence_for<Shapes...>{});
+    });
+    if (best < 0) {
+      // The axis-aligned set's hit, if any.
+      if (!c.shape) return false;
+      c.fill(c.shape, r, c.t, rec);
+      rec.material = c.material;
+      return true;
+    }
+    const prim_ref& p = prims_[static_cast<std::size_t>(best)];
+    if constexpr (has_triangles)
+      if (p.type == triangle_type) {
+        const auto& o = std::get<triangle_type>(objects)[p.object];
+        o.shape.surface_at(r, tri, rec);
+        rec.material = o.material;
+        return true;
+      }
+    fill_ref(p, r, tmax, rec, std::index_sequence_for<Shapes...>{});
+    return true;
+  }
+
+  void add_geometry(const rect& r, std::uint32_t material_index) {
+    if (auto a = as_axis_rect(r, material_index))
+      axis_rects.add(*a);
+    else
+      std::get<std::vector<object<rect>>>(objects).push_back({r, material_index});
+    accel_active_ = false;
+  }
+  template <class Shape>
+  std::uint32_t add_geometry(const Shape& s, std::uint32_t material_index) {
+    auto& v = std::get<std::vector<object<Shape>>>(objects);
+    v.push_back({s, material_index});
+    accel_active_ = false;
+    return static_cast<std::uint32_t>(v.size() - 1);
+  }
+
 
   template <class Shape>
   static void fill_record(const void* s, const ray& r, float t, hit_record& rec) {

@@ -1,0 +1,47 @@
+#pragma once
+// What every BSDF of mcrt/materials/ shares: the transport mode, the sample
+// record, and the conventions (after pbrt-v4, 4th ed., sec. 9.1):
+//
+//  - Directions are in the LOCAL shading frame (shading_frame.hpp): z is the
+//    shading normal, x the tangent (dpdu), along which a microfacet
+//    distribution's alpha_x applies. wo and wi point away from the surface
+//    and are unit length. wo is the direction light leaves along (towards
+//    the camera in radiance mode), wi the one it arrives from.
+//  - f excludes the cosine factor |cos theta_i|: the estimator's weight is
+//    f |cos theta_i| / pdf.
+//  - pdf is per unit SOLID ANGLE of wi, for every non-delta lobe.
+//  - Delta (specular) lobes follow pbrt-v4 exactly: f = F / |cos theta_i|,
+//    pdf = the discrete probability of choosing that lobe and delta = true,
+//    so that f |cos theta_i| / pdf is the weight. eval() and pdf() of a delta
+//    lobe return 0: no other strategy can find its direction.
+//
+// Each BSDF offers the triplet
+//   bool  sample(wo, uc, u, bsdf_sample& out, mode) const;
+//   color eval(wo, wi, mode) const;
+//   float pdf(wo, wi, mode) const;
+//   bool  is_delta() const;
+// with mode defaulted to transport_mode::radiance. sample() returns false
+// when it produces no direction (wo in the tangent plane, a reflected
+// direction below the surface, total internal reflection on the chosen
+// microfacet); the caller then ends the path, as pbrt-v4 does with an empty
+// optional.
+#include "mcrt/core/math.hpp"
+
+namespace mcrt {
+
+// pbrt-v4's TransportMode (4th ed., sec. 9.5.2): radiance when the path
+// started at the camera, importance when it started at a light. Only
+// refraction depends on it: radiance is compressed by 1/eta'^2 when it enters
+// a denser medium (sec. 9.5.2), importance is not.
+enum class transport_mode { radiance, importance };
+
+struct bsdf_sample {
+  vec3 wi{0.0f};        // sampled incident direction, local frame, unit
+  color f{0.0f};        // BSDF value for (wo, wi), without the cosine
+  float pdf = 0;        // solid-angle density, or the lobe probability if delta
+  bool delta = false;   // a specular lobe: pdf is a discrete probability
+  bool transmission = false;  // wi on the other side of the surface than wo
+  float eta = 1;        // relative IOR along the ray for transmission (pbrt-v4's etap), else 1
+};
+
+}  // namespace mcrt

@@ -1,0 +1,953 @@
+#include "pbrt/builder.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <set>
+#include <sstream>
+
+#include "pbrt/ply.hpp"
+#include "pbrt/spectrum.hpp"
+
+namespace mcrt::pbrt {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string quoted(const std::string& s) { return "\"" + s + "\""; }
+
+std::string join_names(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+[[noreturn]] void refuse(const file_loc& loc, const std::string& what) { throw parse_error(loc, what); }
+
+// A directive's parameters as one shape, material, texture ... reads them:
+// each lookup marks the parameter used, and finish() refuses any the
+// directive gave that nothing used (nothing is silently ignored). Attribute
+// defaults of the directive's kind are looked up after its own parameters.
+class params {
+ public:
+  params(const directive& d, const std::vector<param>* defaults = nullptr)
+      : d_(d), defaults_(defaults), what_(d.name + (d.type.empty() ? "" : " " + quoted(d.type))) {}
+
+  const std::string& what() const { return what_; }
+  const file_loc& loc() const { return d_.loc; }
+
+  const param* find(const std::string& name) {
+    for (const param& p : d_.params)
+      if (p.name == name) {
+        used_.insert(&p);
+        return &p;
+      }
+    if (defaults_)
+      for (const param& p : *defaults_)
+        if (p.name == name) return &p;
+    return nullptr;
+  }
+
+  [[noreturn]] void fail(const param& p, const std::string& reason) const {
+    refuse(p.loc, what_ + ": " + quoted(p.type + " " + p.name) + " " + reason);
+  }
+  [[noreturn]] void fail(const std::string& reason) const { refuse(d_.loc, what_ + ": " + reason); }
+
+  void expect_type(const param& p, std::initializer_list<const char*> types) const {
+    for (const char* t : types)
+      if (p.type == t) return;
+    std::string list;
+    for (const char* t : types) list += (list.empty() ? "" : " or ") + std::string(t);
+    fail(p, "must be of type " + list);
+  }
+
+  std::optional<double> number(const std::string& name, std::initializer_list<const char*> types = {"float"}) {
+    const param* p = find(name);
+    if (!p) return std::nullopt;
+    expect_type(*p, types);
+    if (p->numbers.size() != 1) fail(*p, "must have one value, has " + std::to_string(p->size()));
+    return p->numbers[0];
+  }
+  double real(const std::string& name, double def) { return number(name).value_or(def); }
+  int integer(const std::string& name, int def) {
+    const std::optional<double> v = number(name, {"integer"});
+    if (!v) return def;
+    if (*v != std::floor(*v) || std::abs(*v) > 2e9) fail(*find(name), "must be an integer");
+    return static_cast<int>(*v);
+  }
+  bool boolean(const std::string& name, bool def) {
+    const param* p = find(name);
+    if (!p) return def;
+    expect_type(*p, {"bool"});
+    if (p->bools.size() != 1) fail(*p, "must have one value");
+    return p->bools[0];
+  }
+  std::optional<std::string> string(const std::string& name) {
+    const param* p = find(name);
+    if (!p) return std::nullopt;
+    expect_type(*p, {"string"});
+    if (p->strings.size() != 1) fail(*p, "must have one value");
+    return p->strings[0];
+  }
+  std::vector<double> numbers(const std::string& name, std::initializer_list<const char*> types, std::size_t group) {
+    const param* p = find(name);
+    if (!p) return {};
+    expect_type(*p, types);
+    if (p->numbers.size() % group != 0)
+      fail(*p, "must have a multiple of " + std::to_string(group) + " values, has " + std::to_string(p->numbers.size()));
+    return p->numbers;
+  }
+
+  // A parameter mcrt does not implement is accepted at pbrt-v4's default
+  // value only (where it does not change the image).
+  void accept_default(const std::string& name, double def) {
+    const param* p = find(name);
+    if (p && !(p->numbers.size() == 1 && p->numbers[0] == def))
+      fail(*p, "is not supported except at its default " + std::to_string(def));
+  }
+  void accept_default_string(const std::string& name, const std::string& def) {
+    const param* p = find(name);
+    if (p && !(p->strings.size() == 1 && p->strings[0] == def)) fail(*p, "is not supported except at its default " + quoted(def));
+  }
+  // Parameters that do not change the expected image (render options).
+  void accept_any(const std::string& name) { find(name); }
+
+  // Refuses what the directive gave and nothing used.
+  void finish() const {
+    for (const param& p : d_.params)
+      if (!used_.count(&p)) fail(p, "is not supported");
+  }
+
+ private:
+  const directive& d_;
+  const std::vector<param>* defaults_;
+  std::string what_;
+  std::set<const param*> used_;
+};
+
+// What pbrt-v4's graphics state holds that mcrt uses.
+struct graphics_state {
+  transform ctm;
+  bool reverse_orientation = false;
+  // The current material: an index in the scene's materials.
+  std::uint32_t material = 0;
+  // The current area light, if any.
+  struct area_light {
+    color L{0.0f};
+    bool twosided = false;
+    file_loc loc;
+  };
+  std::optional<area_light> light;
+  std::map<std::string, std::vector<param>> attribute_defaults;  // "shape", "light", "material", ...
+};
+
+// A texture in the file: spectrum or float, by name.
+struct texture_entry {
+  std::shared_ptr<const texture> tex;
+  bool is_float = false;
+};
+
+class builder {
+ public:
+  builder(const std::string& dir, const build_options& opt) : dir_(dir), opt_(opt) {
+    // pbrt-v4's default material: diffuse, reflectance 0.5.
+    out_.world.materials.push_back(lambertian{color(0.5f)});
+    state_.material = 0;
+  }
+
+  built_scene run(const std::vector<directive>& ds) {
+    for (const directive& d : ds) step(d);
+    if (!saw_world_) refuse(ds.empty() ? file_loc{} : ds.back().loc, "the file has no WorldBegin");
+    if (!stack_.empty()) refuse(ds.back().loc, "AttributeBegin without AttributeEnd");
+    if (out_.world.object_count() == 0) refuse(ds.back().loc, "the scene has no shapes");
+    out_.world.ray_epsilon = 2e-6f * extent_;
+    out_.world.build_accelerator();
+    return std::move(out_);
+  }
+
+ private:
+  std::string dir_;
+  const build_options& opt_;
+  built_scene out_;
+  graphics_state state_;
+  std::vector<std::pair<graphics_state, bool>> stack_;  // saved states; true: only the transform (TransformBegin)
+  std::map<std::string, transform> coordinate_systems_;
+  std::map<std::string, std::uint32_t> named_materials_;
+  std::map<std::string, texture_entry> spectrum_textures_, float_textures_;
+  bool saw_world_ = false, saw_camera_ = false;
+  float extent_ = 1.0f;
+
+  std::string resolve(const std::string& name) const {
+    const fs::path p(name);
+    return p.is_absolute() || dir_.empty() ? name : (fs::path(dir_) / p).string();
+  }
+
+  void step(const directive& d) {
+    const std::string& n = d.name;
+    if (n == "Identity") {
+      state_.ctm = transform{};
+    } else if (n == "Translate") {
+      state_.ctm = state_.ctm * transform::translate({d.numbers[0], d.numbers[1], d.numbers[2]});
+    } else if (n == "Scale") {
+      state_.ctm = state_.ctm * transform::scale({d.numbers[0], d.numbers[1], d.numbers[2]});
+    } else if (n == "Rotate") {
+      const auto r = transform::rotate(d.numbers[0], {d.numbers[1], d.numbers[2], d.numbers[3]});
+      if (!r) refuse(d.loc, "Rotate: the axis is zero");
+      state_.ctm = state_.ctm * *r;
+    } else if (n == "LookAt") {
+      const auto l = transform::look_at({d.numbers[0], d.numbers[1], d.numbers[2]}, {d.numbers[3], d.numbers[4], d.numbers[5]},
+                                        {d.numbers[6], d.numbers[7], d.numbers[8]});
+      if (!l) refuse(d.loc, "LookAt: the eye is the point looked at, or up is parallel to the view direction");
+      state_.ctm = state_.ctm * *l;
+    } else if (n == "Transform" || n == "ConcatTransform") {
+      std::array<double, 16> m;
+      std::copy(d.numbers.begin(), d.numbers.end(), m.begin());
+      const auto t = transform::from_pbrt_matrix(m);
+      if (!t) refuse(d.loc, n + ": the matrix is singular");
+      state_.ctm = n == "Transform" ? *t : state_.ctm * *t;
+    } else if (n == "CoordinateSystem") {
+      coordinate_systems_[d.strings[0]] = state_.ctm;
+    } else if (n == "CoordSysTransform") {
+      const auto it = coordinate_systems_.find(d.strings[0]);
+      if (it == coordinate_systems_.end()) refuse(d.loc, "CoordSysTransform: no coordinate system named " + quoted(d.strings[0]));
+      state_.ctm = it->second;
+    } else if (n == "ReverseOrientation") {
+      state_.reverse_orientation = !state_.reverse_orientation;
+    } else if (n == "AttributeBegin" || n == "TransformBegin") {
+      stack_.emplace_back(state_, n == "TransformBegin");
+    } else if (n == "AttributeEnd" || n == "TransformEnd") {
+      if (stack_.empty()) refuse(d.loc, n + " without a matching begin");
+      auto [saved, only_transform] = std::move(stack_.back());
+      stack_.pop_back();
+      if (only_transform)
+        state_.ctm = saved.ctm;
+      else
+        state_ = std::move(saved);
+    } else if (n == "Attribute") {
+      const std::string& kind = d.strings[0];
+      if (kind != "shape" && kind != "light" && kind != "material" && kind != "medium" && kind != "texture")
+        refuse(d.loc, "Attribute: unknown kind " + quoted(kind) + " (expected shape, light, material, medium or texture)");
+      auto& defaults = state_.attribute_defaults[kind];
+      for (const param& p : d.params) {
+        std::erase_if(defaults, [&](const param& q) { return q.name == p.name; });
+        defaults.push_back(p);
+      }
+    } else if (n == "WorldBegin") {
+      if (saw_world_) refuse(d.loc, "WorldBegin: a second WorldBegin");
+      saw_world_ = true;
+      if (!saw_camera_) camera_default();
+      state_.ctm = transform{};
+      coordinate_systems_["world"] = transform{};
+    } else if (n == "WorldEnd") {
+      // pbrt-v3's end of the scene: nothing to do.
+    } else if (n == "Camera") {
+      camera(d);
+    } else if (n == "Film") {
+      film(d);
+    } else if (n == "PixelFilter") {
+      pixel_filter_directive(d);
+    } else if (n == "Sampler") {
+      sampler(d);
+    } else if (n == "Integrator") {
+      integrator(d);
+    } else if (n == "Accelerator") {
+      params p(d);
+      for (const param& q : d.params) p.accept_any(q.name);  // the acceleration structure does not change the image
+    } else if (n == "ColorSpace") {
+      if (d.strings[0] != "srgb") refuse(d.loc, "ColorSpace " + quoted(d.strings[0]) + ": not supported (supported: srgb)");
+    } else if (n == "Option") {
+      option(d);
+    } else if (n == "Material") {
+      need_world(d);
+      state_.material = material(d, d.type);
+    } else if (n == "MakeNamedMaterial") {
+      need_world(d);
+      params p(d);
+      const std::optional<std::string> type = p.string("type");
+      if (!type) p.fail("has no \"string type\"");
+      named_materials_[d.strings[0]] = material(d, *type);
+    } else if (n == "NamedMaterial") {
+      need_world(d);
+      const auto it = named_materials_.find(d.strings[0]);
+      if (it == named_materials_.end()) refuse(d.loc, "NamedMaterial: no material named " + quoted(d.strings[0]));
+      state_.material = it->second;
+    } else if (n == "Texture") {
+      need_world(d);
+      texture_directive(d);
+    } else if (n == "AreaLightSource") {
+      need_world(d);
+      area_light(d);
+    } else if (n == "Shape") {
+      need_world(d);
+      shape(d);
+    } else if (n == "MediumInterface") {
+      for (const std::string& s : d.strings)
+        if (!s.empty()) refuse(d.loc, "MediumInterface: participating media are not supported");
+    } else {
+      // LightSource, MakeNamedMedium, ObjectBegin/End/Instance, TransformTimes,
+      // ActiveTransform: known to the parser, not supported here.
+      refuse(d.loc, n + (d.type.empty() ? "" : " " + quoted(d.type)) + ": not supported");
+    }
+  }
+
+  void need_world(const directive& d) const {
+    if (!saw_world_) refuse(d.loc, d.name + ": before WorldBegin");
+  }
+
+  // ---- options: camera, film, filter, sampler, integrator -------------------
+
+  void camera_default() {
+    out_.camera_from_world = transform{};
+    out_.perspective = {};
+  }
+
+  void camera(const directive& d) {
+    if (saw_world_) refuse(d.loc, "Camera: after WorldBegin");
+    saw_camera_ = true;
+    if (d.type != "perspective") refuse(d.loc, "Camera " + quoted(d.type) + ": not supported (supported: perspective)");
+    params p(d);
+    out_.camera_from_world = state_.ctm;
+    coordinate_systems_["camera"] = state_.ctm.inverse();
+    perspective_params& pp = out_.perspective;
+    pp.fov = p.real("fov", 90.0);
+    if (!(pp.fov > 0.0 && pp.fov < 180.0)) p.fail(*p.find("fov"), "must be in (0, 180) degrees");
+    if (const auto a = p.number("frameaspectratio")) {
+      if (!(*a > 0.0)) p.fail(*p.find("frameaspectratio"), "must be > 0");
+      pp.frame_aspect_ratio = *a;
+    }
+    if (const param* sw = p.find("screenwindow")) {
+      p.expect_type(*sw, {"float"});
+      if (sw->numbers.size() != 4) p.fail(*sw, "must have 4 values");
+      if (!(sw->numbers[1] > sw->numbers[0] && sw->numbers[3] > sw->numbers[2])) p.fail(*sw, "must be xmin xmax ymin ymax with xmin < xmax, ymin < ymax");
+      pp.screen_window = std::array<double, 4>{sw->numbers[0], sw->numbers[1], sw->numbers[2], sw->numbers[3]};
+    }
+    p.accept_default("lensradius", 0.0);
+    p.accept_any("focaldistance");  // no effect without a lens
+    p.accept_default("shutteropen", 0.0);
+    p.accept_default("shutterclose", 1.0);
+    p.finish();
+  }
+
+  void film(const directive& d) {
+    if (d.type != "rgb" && d.type != "gbuffer") refuse(d.loc, "Film " + quoted(d.type) + ": not supported (supported: rgb, gbuffer)");
+    params p(d);
+    out_.film.width = p.integer("xresolution", 1280);
+    out_.film.height = p.integer("yresolution", 720);
+    if (out_.film.width < 1 || out_.film.height < 1 || out_.film.width > 16384 || out_.film.height > 16384)
+      p.fail("the resolution must be in [1, 16384] per side");
+    if (const auto f = p.string("filename")) out_.film.filename = *f;
+    p.accept_any("savefp16");  // the output's precision
+    p.accept_any("diagonal");  // the sensor's size: no effect on a perspective image
+    p.accept_default("iso", 100.0);
+    p.accept_default("exposuretime", 1.0);
+    p.accept_default("whitebalance", 0.0);
+    p.accept_default_string("sensor", "cie1931");
+    p.finish();
+  }
+
+  void pixel_filter_directive(const directive& d) {
+    params p(d);
+    filter_desc& f = out_.filter;
+    f.kind = d.type;
+    if (d.type == "box") {
+      f.radius = vec2(0.5f);
+    } else if (d.type == "gaussian") {
+      f.radius = vec2(1.5f);
+      f.sigma = static_cast<float>(p.real("sigma", 0.5));
+      if (!(f.sigma > 0.0f)) p.fail("sigma must be > 0");
+    } else if (d.type == "triangle") {
+      f.radius = vec2(2.0f);
+    } else {
+      refuse(d.loc, "PixelFilter " + quoted(d.type) + ": not supported (supported: box, gaussian, triangle)");
+    }
+    f.radius.x = static_cast<float>(p.real("xradius", f.radius.x));
+    f.radius.y = static_cast<float>(p.real("yradius", f.radius.y));
+    if (!(f.radius.x > 0.0f && f.radius.y > 0.0f)) p.fail("the radii must be > 0");
+    p.finish();
+  }
+
+  void sampler(const directive& d) {
+    params p(d);
+    const std::string& t = d.type;
+    if (t == "independent") {
+      out_.sampler = "independent";
+      out_.spp = p.integer("pixelsamples", 4);
+    } else if (t == "stratified") {
+      out_.sampler = "stratified";
+      const int x = p.integer("xsamples", 4), y = p.integer("ysamples", 4);
+      if (x < 1 || y < 1) p.fail("xsamples and ysamples must be >= 1");
+      out_.spp = x * y;
+      p.accept_any("jitter");  // jittered or not: the expected image is the same
+    } else if (t == "sobol" || t == "zsobol" || t == "paddedsobol" || t == "halton" || t == "pmj02bn") {
+      out_.sampler = "sobol";
+      out_.spp = p.integer("pixelsamples", 16);
+      p.accept_any("randomization");
+    } else {
+      refuse(d.loc, "Sampler " + quoted(t) +
+                        ": not supported (supported: independent, stratified, sobol, zsobol, paddedsobol, halton, pmj02bn)");
+    }
+    p.accept_any("seed");
+    if (out_.spp < 1) p.fail("the sample count must be >= 1");
+    p.finish();
+  }
+
+  void integrator(const directive& d) {
+    if (d.type != "path" && d.type != "volpath")
+      refuse(d.loc, "Integrator " + quoted(d.type) + ": not supported (supported: path, volpath)");
+    params p(d);
+    out_.max_depth = p.integer("maxdepth", 5);
+    if (out_.max_depth < 0) p.fail("maxdepth must be >= 0");
+    if (p.boolean("regularize", false)) p.fail(*p.find("regularize"), "true is not supported");
+    if (const auto ls = p.string("lightsampler")) {
+      if (*ls == "uniform")
+        out_.light_select = "uniform";
+      else if (*ls == "power" || *ls == "bvh")
+        out_.light_select = "power";  // bvh: nearest by power (noise differs, not the expected image)
+      else
+        p.fail(*p.find("lightsampler"), "must be uniform, power or bvh");
+    }
+    p.finish();
+  }
+
+  void option(const directive& d) {
+    for (const param& q : d.params)
+      if (q.name != "rendercoordsys" && q.name != "seed")
+        refuse(q.loc, "Option " + quoted(q.type + " " + q.name) + ": not supported (supported: rendercoordsys, seed)");
+  }
+
+  // ---- spectra, textures, materials ----------------------------------------
+
+  // A spectrum-valued parameter as linear sRGB: rgb as it is, blackbody
+  // normalised to luminance 1 (spectrum.hpp), spectrum values by their
+  // conversion there.
+  std::optional<color> spectrum(params& p, const std::string& name, spectrum_use use) {
+    const param* q = p.find(name);
+    if (!q) return std::nullopt;
+    if (q->type == "rgb" || q->type == "color") {
+      const color c(float(q->numbers[0]), float(q->numbers[1]), float(q->numbers[2]));
+      if (use != spectrum_use::unbounded && (c.r < 0.0f || c.g < 0.0f || c.b < 0.0f)) p.fail(*q, "must not be negative");
+      return c;
+    }
+    if (q->type == "blackbody") {
+      if (q->numbers.size() != 1 || !(q->numbers[0] > 0.0)) p.fail(*q, "must be one temperature > 0 (kelvin)");
+      return blackbody_rgb(q->numbers[0]);
+    }
+    if (q->type == "spectrum") {
+      std::string why;
+      const std::optional<color> c = q->strings.empty() ? sampled_spectrum_rgb(q->numbers, use, why)
+                                                        : named_spectrum_rgb(q->strings[0], use, why);
+      if (!c) p.fail(*q, why);
+      return c;
+    }
+    p.fail(*q, "must be of type rgb, blackbody or spectrum");
+  }
+
+  // A material parameter that may be a texture: its texture, or a constant
+  // one from the value (def where the parameter is absent).
+  std::shared_ptr<const texture> spectrum_texture(params& p, const std::string& name, const color& def,
+                                                  spectrum_use use = spectrum_use::albedo) {
+    const param* q = p.find(name);
+    if (q && q->type == "texture") {
+      const auto it = spectrum_textures_.find(q->strings.at(0));
+      if (it != spectrum_textures_.end()) return it->second.tex;
+      const auto fit = float_textures_.find(q->strings.at(0));
+      if (fit != float_textures_.end()) return fit->second.tex;  // a float texture as a grey spectrum
+      p.fail(*q, "names no texture " + quoted(q->strings.at(0)));
+    }
+    return std::make_shared<texture>(texture::constant(spectrum(p, name, use).value_or(def)));
+  }
+  std::shared_ptr<const texture> float_texture(params& p, const std::string& name, float def) {
+    const param* q = p.find(name);
+    if (q && q->type == "texture") {
+      const auto it = float_textures_.find(q->strings.at(0));
+      if (it == float_textures_.end()) p.fail(*q, "names no float texture " + quoted(q->strings.at(0)));
+      return it->second.tex;
+    }
+    const float v = static_cast<float>(p.real(name, def));
+    return std::make_shared<texture>(texture::constant(color(v)));
+  }
+
+  void texture_directive(const directive& d) {
+    const std::string& name = d.strings[0];
+    const std::string& type = d.strings[1];
+    const std::string& cls = d.strings[2];
+    if (type != "spectrum" && type != "float" && type != "color")
+      refuse(d.loc, "Texture " + quoted(name) + ": type " + quoted(type) + " (expected spectrum or float)");
+    const bool is_float = type == "float";
+    params p(d, attribute_defaults("texture"));
+    auto t = std::make_shared<texture>();
+    const auto mapping = [&] {
+      const std::optional<std::string> m = p.string("mapping");
+      if (m && *m != "uv") p.fail(*p.find("mapping"), "must be uv (the only mapping supported)");
+      t->mapping = {float(p.real("uscale", 1.0)), float(p.real("vscale", 1.0)), float(p.real("udelta", 0.0)),
+                    float(p.real("vdelta", 0.0))};
+    };
+    const auto value = [&](const std::string& pname, float def) {
+      return is_float ? float_texture(p, pname, def) : spectrum_texture(p, pname, color(def));
+    };
+    if (cls == "constant") {
+      t = std::make_shared<texture>(*value("value", 1.0f));
+    } else if (cls == "scale") {
+      t->k = texture::kind::scale;
+      t->a = value("tex", 1.0f);
+      t->b = float_texture(p, "scale", 1.0f);
+    } else if (cls == "checkerboard") {
+      t->k = texture::kind::checkerboard;
+      mapping();
+      if (p.integer("dimension", 2) != 2) p.fail("only dimension 2 is supported");
+      t->a = value("tex1", 1.0f);
+      t->b = value("tex2", 0.0f);
+    } else if (cls == "imagemap") {
+      t->k = texture::kind::image;
+      mapping();
+      const std::optional<std::string> file = p.string("filename");
+      if (!file) p.fail("has no \"string filename\"");
+      const std::string encoding = p.string("encoding").value_or("sRGB");
+      if (!(encoding == "sRGB" || encoding == "linear" || encoding.rfind("gamma ", 0) == 0))
+        p.fail(*p.find("encoding"), "must be sRGB, linear or \"gamma G\"");
+      const std::string wrap = p.string("wrap").value_or("repeat");
+      if (wrap == "repeat")
+        t->wrap = texture_wrap::repeat;
+      else if (wrap == "clamp")
+        t->wrap = texture_wrap::clamp;
+      else if (wrap == "black")
+        t->wrap = texture_wrap::black;
+      else
+        p.fail(*p.find("wrap"), "must be repeat, clamp or black");
+      // The mip-map filters are evaluated bilinearly at the finest level.
+      const std::optional<std::string> filter = p.string("filter");
+      if (filter && *filter != "bilinear" && *filter != "trilinear" && *filter != "ewa" && *filter != "point")
+        p.fail(*p.find("filter"), "must be point, bilinear, trilinear or ewa");
+      p.accept_any("maxanisotropy");
+      t->value = color(float(p.real("scale", 1.0)));
+      t->invert = p.boolean("invert", false);
+      if (!opt_.decode_image) p.fail("images cannot be decoded here");
+      const std::string path = resolve(*file);
+      try {
+        auto img = std::make_shared<texture_image>(opt_.decode_image(path, encoding));
+        if (is_float)
+          for (color& c : img->texels) c = color((c.r + c.g + c.b) / 3.0f);
+        t->img = std::move(img);
+      } catch (const parse_error&) {
+        throw;
+      } catch (const std::exception& e) {
+        refuse(p.loc(), "Texture " + quoted(name) + ": " + path + ": " + e.what());
+      }
+    } else {
+      refuse(d.loc, "Texture " + quoted(name) + " class " + quoted(cls) +
+                        ": not supported (supported: imagemap, constant, scale, checkerboard)");
+    }
+    p.finish();
+    (is_float ? float_textures_ : spectrum_textures_)[name] = {t, is_float};
+  }
+
+  const std::vector<param>* attribute_defaults(const std::string& kind) const {
+    const auto it = state_.attribute_defaults.find(kind);
+    return it == state_.attribute_defaults.end() ? nullptr : &it->second;
+  }
+
+  // Makes the material of a Material or MakeNamedMaterial directive and
+  // returns its index.
+  std::uint32_t material(const directive& d, const std::string& type) {
+    params p(d, attribute_defaults("material"));
+    if (d.name == "MakeNamedMaterial") p.string("type");
+    if (p.find("displacement")) p.fail(*p.find("displacement"), "is not supported");
+    if (p.find("normalmap")) p.fail(*p.find("normalmap"), "is not supported");
+    mcrt::material m;
+    if (type == "diffuse") {
+      const std::shared_ptr<const texture> r = spectrum_texture(p, "reflectance", color(0.5f));
+      if (r->is_constant())
+        m = lambertian{glm::clamp(r->value, color(0.0f), color(1.0f))};
+      else
+        m = textured_diffuse{*r};
+    } else if (type == "conductor") {
+      conductor_material c;
+      const bool has_ior = p.find("eta") || p.find("k");
+      if (p.find("reflectance")) {
+        if (has_ior) p.fail("gives both reflectance and eta/k (pbrt-v4 refuses that too)");
+        c.reflectance = spectrum_texture(p, "reflectance", color(0.0f));
+      } else {
+        // pbrt-v4's default conductor is copper.
+        std::string why;
+        c.eta = spectrum_texture(p, "eta", *named_spectrum_rgb("metal-Cu-eta", spectrum_use::unbounded, why),
+                                 spectrum_use::unbounded);
+        c.k = spectrum_texture(p, "k", *named_spectrum_rgb("metal-Cu-k", spectrum_use::unbounded, why),
+                               spectrum_use::unbounded);
+      }
+      c.roughness = roughness(p);
+      m = c;
+    } else if (type == "dielectric") {
+      dielectric_material g;
+      if (const param* e = p.find("eta")) {
+        if (e->type == "float") {
+          g.eta = static_cast<float>(p.real("eta", 1.5));
+        } else if (e->type == "spectrum") {
+          // One IOR for the three channels: a named glass's at 550 nm, a
+          // sampled spectrum's at 532 nm (mcrt renders no dispersion).
+          g.eta = spectrum(p, "eta", spectrum_use::unbounded)->g;
+        } else {
+          p.fail(*e, "must be a float or a spectrum (textured IORs are not supported)");
+        }
+        if (!(g.eta > 0.0f) || !std::isfinite(g.eta)) p.fail(*e, "must be > 0");
+      }
+      g.roughness = roughness(p);
+      m = g;
+    } else {
+      refuse(d.loc, d.name + " " + quoted(type) + ": not supported (supported: diffuse, conductor, dielectric)");
+    }
+    p.finish();
+    out_.world.materials.push_back(m);
+    return static_cast<std::uint32_t>(out_.world.materials.size() - 1);
+  }
+
+  // pbrt-v4's roughness parameters: uroughness and vroughness, each
+  // `roughness` (default 0) where absent; remaproughness (default true).
+  microfacet_roughness roughness(params& p) {
+    microfacet_roughness r;
+    const std::shared_ptr<const texture> both = float_texture(p, "roughness", 0.0f);
+    r.u = p.find("uroughness") ? float_texture(p, "uroughness", 0.0f) : both;
+    r.v = p.find("vroughness") ? float_texture(p, "vroughness", 0.0f) : both;
+    r.remap = p.boolean("remaproughness", true);
+    return r;
+  }
+
+  void area_light(const directive& d) {
+    if (d.type != "diffuse") refuse(d.loc, "AreaLightSource " + quoted(d.type) + ": not supported (supported: diffuse)");
+    params p(d, attribute_defaults("light"));
+    graphics_state::area_light l;
+    l.loc = d.loc;
+    // pbrt-v4's DiffuseAreaLight::Create: L (default the illuminant, white
+    // of luminance 1 here), scale divided by L's luminance (an rgb L is
+    // taken as it is: mcrt renders in RGB, pbrt-v4 divides by its
+    // illuminant's luminance only).
+    const param* lp = p.find("L");
+    color L = spectrum(p, "L", spectrum_use::illuminant).value_or(color(1.0f));
+    const float scale = static_cast<float>(p.real("scale", 1.0));
+    L *= scale;
+    l.twosided = p.boolean("twosided", false);
+    (void)lp;
+    if (p.find("filename")) p.fail(*p.find("filename"), "(an image on the light) is not supported");
+    if (p.find("power")) p.fail(*p.find("power"), "is not supported");
+    p.finish();
+    l.L = L;
+    state_.light = l;
+  }
+
+  // ---- shapes ----------------------------------------------------------------
+
+  void grow_extent(const aabb& b) {
+    extent_ = std::max({extent_, std::abs(b.lo.x), std::abs(b.lo.y), std::abs(b.lo.z), std::abs(b.hi.x), std::abs(b.hi.y),
+                        std::abs(b.hi.z)});
+  }
+
+  // The material a shape gets: its own, or for an emitter a diffuse_light
+  // that reflects with it.
+  std::uint32_t shape_material(bool& emits) {
+    emits = state_.light && state_.light->L != color(0.0f);
+    if (!emits) return state_.material;
+    diffuse_light dl;
+    dl.emit = state_.light->L;
+    dl.twosided = state_.light->twosided;
+    // A black diffuse material reflects nothing: the light is a pure emitter.
+    const mcrt::material& m = out_.world.materials[state_.material];
+    const auto* lam = std::get_if<lambertian>(&m);
+    dl.surface = lam && lam->albedo == color(0.0f) ? diffuse_light::no_surface : state_.material;
+    out_.world.materials.push_back(dl);
+    return static_cast<std::uint32_t>(out_.world.materials.size() - 1);
+  }
+
+  light_sampling strategy_for(const std::string& shape, const file_loc& loc, light_sampling def) const {
+    if (!opt_.strategy) return def;
+    if (*opt_.strategy == light_sampling::automatic)
+      refuse(loc, "--light-sampling auto: not available for pbrt-v4 scenes");
+    if (shape == "triangle" && *opt_.strategy != light_sampling::area)
+      refuse(loc, "--light-sampling " + std::string(to_string(*opt_.strategy)) +
+                      ": triangle lights are sampled by area only");
+    return *opt_.strategy;
+  }
+
+  // Registers an emitter's light(s): one, or for a two-sided light its
+  // front and its back (each a one-sided light sampled from its own side,
+  // so every strategy serves both and the power counts both).
+  template <class Front, class Back>
+  void add_emitter(Front&& front, Back&& back, bool twosided, std::uint32_t mat) {
+    std::vector<std::uint32_t> entries;
+    entries.push_back(static_cast<std::uint32_t>(out_.world.emitters.size()));
+    front(mat);
+    if (twosided) {
+      entries.push_back(static_cast<std::uint32_t>(out_.world.emitters.size()));
+      back(mat);
+    }
+    out_.file_lights.push_back(std::move(entries));
+  }
+
+  void add_light_only(const light& l, std::uint32_t mat) {
+    const auto k = static_cast<std::uint32_t>(out_.world.lights.size());
+    out_.world.lights.push_back(l);
+    const auto& e = std::get<diffuse_light>(out_.world.materials[mat]);
+    out_.world.emitters.push_back({k, pi * surface_area(l) * luminance(e.emit)});
+  }
+
+  void shape(const directive& d) {
+    params p(d, attribute_defaults("shape"));
+    p.accept_any("alpha");
+    if (const param* a = p.find("alpha"))
+      if (!(a->type == "float" && a->numbers.size() == 1 && a->numbers[0] == 1.0)) p.fail(*a, "(cut-outs) is not supported");
+    p.accept_any("emissionfilename");
+    if (p.find("emissionfilename")) p.fail(*p.find("emissionfilename"), "is not supported");
+    const std::string& t = d.type;
+    if (t == "trianglemesh") {
+      triangle_mesh m;
+      const std::vector<double> P = p.numbers("P", {"point3", "point"}, 3);
+      if (P.empty()) p.fail("has no \"point3 P\"");
+      for (std::size_t i = 0; i < P.size(); i += 3) m.p.push_back(vec3(float(P[i]), float(P[i + 1]), float(P[i + 2])));
+      std::vector<double> idx = p.numbers("indices", {"integer"}, 3);
+      if (idx.empty()) {
+        if (m.p.size() != 3) p.fail("has no \"integer indices\" (allowed only for a single triangle of 3 points)");
+        idx = {0, 1, 2};
+      }
+      for (const double v : idx) {
+        if (v < 0 || v >= double(m.p.size()) || v != std::floor(v))
+          p.fail(*p.find("indices"), "has an index out of range: " + std::to_string(static_cast<long long>(v)) + " (" +
+                                         std::to_string(m.p.size()) + " points)");
+        m.indices.push_back(static_cast<std::uint32_t>(v));
+      }
+      const std::vector<double> N = p.numbers("N", {"normal", "normal3"}, 3);
+      if (!N.empty()) {
+        if (N.size() != P.size()) p.fail(*p.find("N"), "must have one normal per point");
+        for (std::size_t i = 0; i < N.size(); i += 3) m.n.push_back(vec3(float(N[i]), float(N[i + 1]), float(N[i + 2])));
+      }
+      std::vector<double> uv = p.numbers("uv", {"point2", "float"}, 2);
+      if (uv.empty()) uv = p.numbers("st", {"point2", "float"}, 2);
+      if (!uv.empty()) {
+        if (uv.size() / 2 != m.p.size()) p.fail("uv must have one point per point");
+        for (std::size_t i = 0; i < uv.size(); i += 2) m.uv.push_back(vec2(float(uv[i]), float(uv[i + 1])));
+      }
+      if (p.find("S")) p.fail(*p.find("S"), "(shading tangents) is not supported");
+      p.accept_any("faceIndices");  // face numbers matter only to Ptex textures
+      p.finish();
+      add_mesh(std::move(m), p);
+    } else if (t == "plymesh") {
+      const std::optional<std::string> file = p.string("filename");
+      if (!file) p.fail("has no \"string filename\"");
+      if (p.find("displacement")) p.fail(*p.find("displacement"), "is not supported");
+      p.accept_default("edgelength", 1.0);
+      p.finish();
+      triangle_mesh m;
+      try {
+        m = read_ply(resolve(*file));
+      } catch (const parse_error& e) {
+        // Both places: the directive, and the PLY file's own.
+        p.fail(e.what());
+      }
+      add_mesh(std::move(m), p);
+    } else if (t == "bilinearmesh") {
+      bilinear_mesh(p);
+    } else if (t == "sphere") {
+      sphere_shape(p);
+    } else if (t == "disk") {
+      disk_shape(p);
+    } else {
+      refuse(d.loc, "Shape " + quoted(t) + ": not supported (supported: trianglemesh, plymesh, bilinearmesh, sphere, disk)");
+    }
+  }
+
+  // A mesh in object space: moved to the world by the CTM, checked, added
+  // with the current material, and its triangles as lights where it emits.
+  void add_mesh(triangle_mesh m, params& p) {
+    const transform& x = state_.ctm;
+    for (vec3& v : m.p) {
+      v = vec3(x.point(glm::dvec3(v)));
+      if (!all_finite(v)) p.fail("has a point that is not finite (after the transformation)");
+    }
+    for (vec3& n : m.n) {
+      const glm::dvec3 w = x.normal(glm::dvec3(n));
+      const double len = glm::length(w);
+      n = len > 0.0 ? vec3(w / len) : vec3(0.0f);
+    }
+    // pbrt-v4's triangles: the geometric normal is the world-space cross
+    // product, reversed by ReverseOrientation and by a transform that swaps
+    // handedness (Triangle::InteractionFromIntersection), or turned to the
+    // shading normals where the mesh has them.
+    m.reverse_orientation = state_.reverse_orientation != x.swaps_handedness();
+    auto mesh = std::make_shared<const triangle_mesh>(std::move(m));
+    bool emits = false;
+    const std::uint32_t mat = shape_material(emits);
+    if (emits) strategy_for("triangle", p.loc(), light_sampling::area);
+    for (const triangle& tri : triangles_of(mesh)) {
+      if (tri.area() == 0.0f) continue;  // a degenerate triangle is never hit
+      grow_extent(tri.bounds());
+      out_.world.add(tri, mat);
+      if (emits) {
+        const triangle_area_sampler front(tri);
+        add_emitter([&](std::uint32_t mm) { add_light_only(front, mm); },
+                    [&](std::uint32_t mm) {
+                      triangle_area_sampler back = front;
+                      back.n = -back.n;
+                      add_light_only(back, mm);
+                    },
+                    state_.light->twosided, mat);
+      }
+    }
+  }
+
+  void bilinear_mesh(params& p) {
+    const std::vector<double> P = p.numbers("P", {"point3", "point"}, 3);
+    if (P.empty()) p.fail("has no \"point3 P\"");
+    triangle_mesh m;
+    for (std::size_t i = 0; i < P.size(); i += 3) m.p.push_back(vec3(float(P[i]), float(P[i + 1]), float(P[i + 2])));
+    std::vector<double> idx = p.numbers("indices", {"integer"}, 4);
+    if (idx.empty()) {
+      if (m.p.size() != 4) p.fail("has no \"integer indices\" (allowed only for a single patch of 4 points)");
+      idx = {0, 1, 2, 3};
+    }
+    const std::vector<double> N = p.numbers("N", {"normal", "normal3"}, 3);
+    if (!N.empty()) {
+      if (N.size() != P.size()) p.fail(*p.find("N"), "must have one normal per point");
+      for (std::size_t i = 0; i < N.size(); i += 3) m.n.push_back(vec3(float(N[i]), float(N[i + 1]), float(N[i + 2])));
+    }
+    const std::vector<double> uv = p.numbers("uv", {"point2"}, 2);
+    if (!uv.empty()) {
+      if (uv.size() / 2 != m.p.size()) p.fail("uv must have one point per point");
+      for (std::size_t i = 0; i < uv.size(); i += 2) m.uv.push_back(vec2(float(uv[i]), float(uv[i + 1])));
+    } else {
+      // pbrt-v4's patch parameterisation: p00 (0,0), p10 (1,0), p01 (0,1),
+      // p11 (1,1); on a planar parallelogram the triangles interpolate it
+      // exactly. Points shared by patches with different corners get the
+      // first patch's; mcrt's triangles then differ from pbrt-v4's
+      // bilinear (u, v) (textures only).
+      m.uv.assign(m.p.size(), vec2(0.0f));
+    }
+    p.accept_any("faceIndices");
+    p.finish();
+    for (std::size_t i = 0; i < idx.size(); i += 4) {
+      std::array<std::uint32_t, 4> v;
+      for (int k = 0; k < 4; ++k) {
+        const double x = idx[i + std::size_t(k)];
+        if (x < 0 || x >= double(m.p.size()) || x != std::floor(x))
+          p.fail(*p.find("indices"), "has an index out of range: " + std::to_string(static_cast<long long>(x)));
+        v[std::size_t(k)] = static_cast<std::uint32_t>(x);
+      }
+      // Patch p00 p10 p01 p11 -> the quad p00 p10 p11 p01 -> triangles
+      // (p00, p10, p11) and (p00, p11, p01); their normal is the patch's
+      // cross(p10 - p00, p01 - p00) where the patch is planar and convex.
+      const vec3 a = m.p[v[0]], b = m.p[v[1]], c = m.p[v[3]], e = m.p[v[2]];
+      const vec3 n = glm::cross(b - a, e - a);
+      const float scale = glm::length(b - a) + glm::length(c - a) + glm::length(e - a);
+      if (std::abs(glm::dot(glm::normalize(n), c - a)) > 1e-5f * scale)
+        p.fail("patch " + std::to_string(i / 4) + " is not planar (bilinear patches are supported when planar)");
+      if (glm::dot(glm::cross(b - a, c - a), n) <= 0.0f || glm::dot(glm::cross(c - a, e - a), n) <= 0.0f)
+        p.fail("patch " + std::to_string(i / 4) + " is not convex");
+      if (uv.empty()) {
+        m.uv[v[0]] = {0, 0};
+        m.uv[v[1]] = {1, 0};
+        m.uv[v[2]] = {0, 1};
+        m.uv[v[3]] = {1, 1};
+      }
+      m.indices.insert(m.indices.end(), {v[0], v[1], v[3], v[0], v[3], v[2]});
+    }
+    add_mesh(std::move(m), p);
+  }
+
+  // The CTM as a similarity (rotation, uniform scale, translation, perhaps
+  // a mirror): its scale, or nullopt.
+  std::optional<double> similarity_scale() const {
+    const glm::dmat3 a(state_.ctm.m);
+    const double s0 = glm::length(a[0]), s1 = glm::length(a[1]), s2 = glm::length(a[2]);
+    const double s = (s0 + s1 + s2) / 3.0;
+    const double tol = 1e-6 * s;
+    if (std::abs(s0 - s) > tol || std::abs(s1 - s) > tol || std::abs(s2 - s) > tol) return std::nullopt;
+    if (std::abs(glm::dot(a[0], a[1])) > tol * s || std::abs(glm::dot(a[1], a[2])) > tol * s ||
+        std::abs(glm::dot(a[0], a[2])) > tol * s)
+      return std::nullopt;
+    return s;
+  }
+
+  void sphere_shape(params& p) {
+    const double r = p.real("radius", 1.0);
+    if (!(r > 0.0)) p.fail("radius must be > 0");
+    p.accept_default("zmin", -r);
+    p.accept_default("zmax", r);
+    p.accept_default("phimax", 360.0);
+    p.finish();
+    const std::optional<double> s = similarity_scale();
+    if (!s) p.fail("a sphere under a transformation that is not a similarity (an ellipsoid) is not supported");
+    sphere sp;
+    sp.center = vec3(state_.ctm.point({0, 0, 0}));
+    sp.radius = static_cast<float>(r * *s);
+    // pbrt-v4's intersection: the outward normal, flipped by
+    // ReverseOrientation and by a transform that swaps handedness.
+    sp.flip = state_.reverse_orientation != state_.ctm.swaps_handedness();
+    grow_extent(sp.bounds());
+    bool emits = false;
+    const std::uint32_t mat = shape_material(emits);
+    if (!emits) {
+      out_.world.add(sp, mat);
+      return;
+    }
+    if (state_.light->twosided) p.fail("a two-sided sphere light is not supported");
+    out_.world.add(sp, mat);
+    const light_sampling st = strategy_for("sphere", p.loc(), light_sampling::solid_angle);
+    add_emitter([&](std::uint32_t mm) { add_light_only(sphere_light(sp, st), mm); }, [](std::uint32_t) {}, false, mat);
+  }
+
+  static light sphere_light(const sphere& s, light_sampling st) {
+    switch (st) {
+      case light_sampling::area: return sphere_area_sampler{s};
+      case light_sampling::projected_solid_angle:
+      case light_sampling::bilinear_solid_angle: return sphere_projected_solid_angle_sampler{s};
+      default: return sphere_cone_sampler{s};
+    }
+  }
+  static light ellipse_light(const ellipse& e, light_sampling st) {
+    switch (st) {
+      case light_sampling::solid_angle: return ellipse_solid_angle_sampler{e};
+      case light_sampling::projected_solid_angle: return ellipse_projected_solid_angle_sampler{e};
+      case light_sampling::bilinear_solid_angle: return ellipse_bilinear_solid_angle_sampler{e};
+      default: return ellipse_area_sampler{e};
+    }
+  }
+
+  void disk_shape(params& p) {
+    const double r = p.real("radius", 1.0), h = p.real("height", 0.0);
+    if (!(r > 0.0)) p.fail("radius must be > 0");
+    p.accept_default("innerradius", 0.0);
+    p.accept_default("phimax", 360.0);
+    p.finish();
+    const transform& x = state_.ctm;
+    const glm::dvec3 c = x.point({0, 0, h}), a1 = x.vector({r, 0, 0}), a2 = x.vector({0, r, 0});
+    if (std::abs(glm::dot(a1, a2)) > 1e-6 * glm::length(a1) * glm::length(a2))
+      p.fail("a disk under a shear (its axes no longer orthogonal) is not supported");
+    // pbrt-v4's intersection: the transformed +z normal, flipped by
+    // ReverseOrientation and by a transform that swaps handedness.
+    glm::dvec3 n = x.normal({0, 0, 1});
+    if (state_.reverse_orientation != x.swaps_handedness()) n = -n;
+    const bool flip = glm::dot(glm::cross(a1, a2), n) < 0.0;
+    const ellipse e = ellipse::make(vec3(c), vec3(a1), vec3(a2), flip);
+    grow_extent(e.bounds());
+    bool emits = false;
+    const std::uint32_t mat = shape_material(emits);
+    out_.world.add(e, mat);
+    if (!emits) return;
+    const light_sampling st = strategy_for("disk", p.loc(), light_sampling::area);
+    add_emitter([&](std::uint32_t mm) { add_light_only(ellipse_light(e, st), mm); },
+                [&](std::uint32_t mm) { add_light_only(ellipse_light(ellipse::make(vec3(c), vec3(a1), vec3(a2), !flip), st), mm); },
+                state_.light->twosided, mat);
+  }
+};
+
+}  // namespace
+
+built_scene build_scene(const std::vector<directive>& directives, const std::string& scene_directory,
+                        const build_options& options) {
+  builder b(scene_directory, options);
+  return b.run(directives);
+}
+
+built_scene load_pbrt_file(const std::string& path, const build_options& options) {
+  const std::vector<directive> ds = parse_file(path);
+  return build_scene(ds, fs::path(path).parent_path().string(), options);
+}
+
+}  // namespace mcrt::pbrt

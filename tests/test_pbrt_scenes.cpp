@@ -1,0 +1,474 @@
+// pbrt-v4 scene files through the builder (src/pbrt/builder.hpp): direct
+// light on a diffuse floor under lights placed by nested transforms,
+// ReverseOrientation, a mirroring transform, a PLY quad and a two-sided
+// light, against Lambert's polygon formula and the disk's and sphere's
+// closed forms, under every integrator; the Cornell box of a pbrt file
+// against the same box in the JSON format; and the refusals of the
+// contract's "Errors" (one line naming the file and line).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <string>
+
+#include "pbrt/builder.hpp"
+#include "scene_loader.hpp"
+#include "support/lambert.hpp"
+#include "support/radiance_estimate.hpp"
+
+using namespace mcrt;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double albedo = 0.5, emit = 4.0;
+
+// A directory of its own for each test's files.
+fs::path scratch(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("mcrt_test_pbrt_scenes_" + std::to_string(::getpid())) / name;
+  fs::create_directories(d);
+  return d;
+}
+
+pbrt::built_scene from_text(const std::string& text, const std::string& dir = "") {
+  pbrt::parse_options po;
+  po.search_directory = dir;
+  return pbrt::build_scene(pbrt::parse_text(text, "test.pbrt", po), dir);
+}
+
+// A 10 x 10 floor at y = 0 of albedo 0.5, then the scene's lights. Rays
+// leave a triangle from its hit point moved off the surface by the bound of
+// that point's rounding (about 4e-7 |p|, hit_record::spawn_origin): on a
+// floor of +-50 the light samples would start 2e-5 above it and see a few
+// 1e-6 more light than the closed form at y = 0, more than the references'
+// tolerance for rounding (1e-6); on +-5 the shift is ten times smaller.
+std::string floor_scene(const std::string& lights) {
+  return R"(Camera "perspective"
+WorldBegin
+Material "diffuse" "rgb reflectance" [ 0.5 0.5 0.5 ]
+Shape "trianglemesh" "point3 P" [ -5 0 -5  5 0 -5  5 0 5  -5 0 5 ] "integer indices" [ 0 1 2  0 2 3 ]
+)" + lights;
+}
+
+test::estimate floor_radiance(const scene& sc, integrator_kind ik, float x, float z, int id) {
+  // One scattering event (the floor's): direct light only.
+  return test::radiance_along(sc, ray{{x, 0.5f, z}, {0, -1, 0}}, path_settings{1, 3}, ik, sampler_kind::sobol, 32, 4096,
+                              id, 7 + static_cast<std::uint64_t>(id));
+}
+
+void check(const test::estimate& e, double exact, const std::string& what) {
+  EXPECT_LE(std::abs(e.mean - exact), std::max(6.0 * e.stderr_, 1e-6 * exact))
+      << what << ": mean " << e.mean << " exact " << exact << " stderr " << e.stderr_;
+  EXPECT_LE(std::abs(e.mean - exact), 0.01 * exact) << what << ": mean " << e.mean << " exact " << exact;
+}
+
+double polygon_floor(const std::vector<glm::dvec3>& poly, double x, double z) {
+  return albedo / std::numbers::pi * test::polygon_irradiance({x, 0.0, z}, {0.0, 1.0, 0.0}, poly, emit);
+}
+
+// The vertices of the scene's triangles after the first (the floor's
+// two), as built: the references take the geometry in float as the scene
+// holds it, and the vertices are checked against the expected ones apart.
+std::vector<std::vector<glm::dvec3>> light_triangles(const scene& sc) {
+  std::vector<std::vector<glm::dvec3>> out;
+  const auto& tris = std::get<std::vector<object<triangle>>>(sc.objects);
+  for (std::size_t i = 2; i < tris.size(); ++i) {
+    const triangle& t = tris[i].shape;
+    out.push_back({glm::dvec3(t.vertex(0)), glm::dvec3(t.vertex(1)), glm::dvec3(t.vertex(2))});
+  }
+  return out;
+}
+
+void expect_vertices(const std::vector<glm::dvec3>& got, const std::vector<glm::dvec3>& want) {
+  ASSERT_EQ(got.size(), want.size());
+  for (std::size_t i = 0; i < got.size(); ++i)
+    EXPECT_LT(glm::length(got[i] - want[i]), 1e-6) << "vertex " << i;
+}
+
+const std::vector<std::pair<float, float>> floor_points{{0.1f, 0.0f}, {0.4f, 0.3f}, {-0.6f, -0.5f}, {1.5f, 1.0f}};
+
+class PbrtFloor : public ::testing::TestWithParam<integrator_kind> {};
+
+std::string integrator_name(const ::testing::TestParamInfo<integrator_kind>& info) { return std::string(to_string(info.param)); }
+
+// A triangle given in the z = 0 plane of its object space, clockwise seen
+// from +z (its normal -z), turned by Rotate 90 about x to face up, then
+// reversed by ReverseOrientation to face the floor, inside nested
+// transforms: the world triangle is (-0.3, 1, -0.3), (0.2, 1, 0.5),
+// (0.7, 1, -0.2).
+const char* nested_triangle = R"(
+AttributeBegin
+  Translate 0.1 0 0
+  AttributeBegin
+    Translate 0 1 0
+    Rotate 90 1 0 0
+    ReverseOrientation
+    AreaLightSource "diffuse" "rgb L" [ 4 4 4 ] %s
+    Material "diffuse" "rgb reflectance" [ 0 0 0 ]
+    Shape "trianglemesh" "point3 P" [ -0.4 -0.3 0  0.1 0.5 0  0.6 -0.2 0 ] "integer indices" [ 0 1 2 ]
+  AttributeEnd
+AttributeEnd
+)";
+
+std::string with(const char* fmt, const std::string& arg) {
+  std::string out(fmt);
+  out.replace(out.find("%s"), 2, arg);
+  return out;
+}
+
+TEST_P(PbrtFloor, TriangleByNestedTransformsAndReverseOrientation) {
+  const pbrt::built_scene b = from_text(floor_scene(with(nested_triangle, "")));
+  ASSERT_EQ(b.world.emitters.size(), 1u);
+  const std::vector<glm::dvec3> poly = light_triangles(b.world).at(0);
+  expect_vertices(poly, {{-0.3, 1, -0.3}, {0.2, 1, 0.5}, {0.7, 1, -0.2}});
+  int id = 0;
+  for (const auto& [x, z] : floor_points) check(floor_radiance(b.world, GetParam(), x, z, id++), polygon_floor(poly, x, z), "triangle");
+}
+
+// Without ReverseOrientation the same triangle faces up: the floor gets nothing.
+TEST_P(PbrtFloor, ReverseOrientationDecidesTheEmittingSide) {
+  std::string text = floor_scene(with(nested_triangle, ""));
+  text.erase(text.find("ReverseOrientation"), std::string("ReverseOrientation").size());
+  const pbrt::built_scene b = from_text(text);
+  EXPECT_EQ(floor_radiance(b.world, GetParam(), 0.1f, 0.0f, 50).mean, 0.0);
+}
+
+// Two-sided: the up-facing triangle lights the floor with its back, and its
+// power counts both sides.
+TEST_P(PbrtFloor, TwoSidedTriangleLightsFromItsBack) {
+  std::string text = floor_scene(with(nested_triangle, "\"bool twosided\" true"));
+  text.erase(text.find("ReverseOrientation"), std::string("ReverseOrientation").size());
+  const pbrt::built_scene b = from_text(text);
+  ASSERT_EQ(b.file_lights.size(), 1u);
+  ASSERT_EQ(b.file_lights[0].size(), 2u);
+  ASSERT_EQ(b.world.emitters.size(), 2u);
+  EXPECT_FLOAT_EQ(b.world.emitters[0].power, b.world.emitters[1].power);
+  const std::vector<glm::dvec3> poly = light_triangles(b.world).at(0);
+  expect_vertices(poly, {{-0.3, 1, -0.3}, {0.2, 1, 0.5}, {0.7, 1, -0.2}});
+  int id = 60;
+  for (const auto& [x, z] : floor_points) check(floor_radiance(b.world, GetParam(), x, z, id++), polygon_floor(poly, x, z), "two-sided");
+}
+
+// A quad from a PLY file, mirrored by Scale -1 1 1: pbrt-v4 reverses a
+// triangle's world-space normal under a transform that swaps handedness, so
+// the quad, which faces down in its file, still faces down.
+TEST_P(PbrtFloor, PlyQuadUnderAMirror) {
+  const fs::path dir = scratch("ply_quad");
+  {
+    std::ofstream ply(dir / "quad.ply");
+    ply << "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+           "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+           "-0.3 0 -0.2\n0.3 0 -0.2\n0.3 0 0.2\n-0.3 0 0.2\n4 0 1 2 3\n";
+  }
+  const pbrt::built_scene b = from_text(floor_scene(R"(
+AttributeBegin
+  Translate 0.05 1 0
+  Scale -1 1 1
+  AreaLightSource "diffuse" "rgb L" [ 4 4 4 ]
+  Material "diffuse" "rgb reflectance" [ 0 0 0 ]
+  Shape "plymesh" "string filename" "quad.ply"
+AttributeEnd
+)"),
+                                        dir.string());
+  ASSERT_EQ(b.world.emitters.size(), 2u);  // the quad's two triangles
+  // The PLY quad v0 v1 v2 v3 as the triangles v0 v1 v2 and v0 v2 v3.
+  const auto tris = light_triangles(b.world);
+  ASSERT_EQ(tris.size(), 2u);
+  const std::vector<glm::dvec3> poly{tris[0][0], tris[0][1], tris[0][2], tris[1][2]};
+  expect_vertices(poly, {{0.35, 1, -0.2}, {-0.25, 1, -0.2}, {-0.25, 1, 0.2}, {0.35, 1, 0.2}});
+  int id = 10;
+  for (const auto& [x, z] : floor_points) check(floor_radiance(b.world, GetParam(), x, z, id++), polygon_floor(poly, x, z), "PLY quad");
+}
+
+// A disk of radius 0.5 at height 0.8: pbrt's +z normal turned by Rotate 90
+// about x to face down.
+TEST_P(PbrtFloor, DiskTurnedToFaceDown) {
+  const pbrt::built_scene b = from_text(floor_scene(R"(
+AttributeBegin
+  Translate 0 0.8 0
+  Rotate 90 1 0 0
+  AreaLightSource "diffuse" "rgb L" [ 4 4 4 ]
+  Material "diffuse" "rgb reflectance" [ 0 0 0 ]
+  Shape "disk" "float radius" 0.5
+AttributeEnd
+)"));
+  int id = 20;
+  for (const float d : {0.0f, 0.3f, 0.6f, 2.0f})
+    check(floor_radiance(b.world, GetParam(), d, 0.0f, id++), albedo / std::numbers::pi * test::disk_irradiance(0.8, d, 0.5, emit),
+          "disk at d=" + std::to_string(d));
+}
+
+// A sphere of radius 0.35 (a unit sphere scaled) at (0.1, 0.9, -0.05).
+TEST_P(PbrtFloor, SphereScaledAndMoved) {
+  const pbrt::built_scene b = from_text(floor_scene(R"(
+AttributeBegin
+  Translate 0.1 0.9 -0.05
+  Scale 0.35 0.35 0.35
+  AreaLightSource "diffuse" "rgb L" [ 4 4 4 ]
+  Material "diffuse" "rgb reflectance" [ 0 0 0 ]
+  Shape "sphere"
+AttributeEnd
+)"));
+  const auto& spheres = std::get<std::vector<object<sphere>>>(b.world.objects);
+  ASSERT_EQ(spheres.size(), 1u);
+  const glm::dvec3 c(spheres[0].shape.center);
+  const double r = spheres[0].shape.radius;
+  EXPECT_LT(glm::length(c - glm::dvec3(0.1, 0.9, -0.05)), 1e-6);
+  EXPECT_NEAR(r, 0.35, 1e-6);
+  EXPECT_FALSE(spheres[0].shape.flip);
+  int id = 30;
+  for (const auto& [x, z] : floor_points) {
+    const glm::dvec3 w = c - glm::dvec3(x, 0.0, z);
+    const double d2 = glm::dot(w, w);
+    check(floor_radiance(b.world, GetParam(), x, z, id++), albedo * emit * (r * r / d2) * (w.y / std::sqrt(d2)), "sphere");
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(All, PbrtFloor, ::testing::Values(integrator_kind::mixture, integrator_kind::nee, integrator_kind::mis),
+                         integrator_name);
+
+// A light's emitting material reflects with the shape's own material: a
+// white diffuse emitter lit by another light sends back more than its
+// emission (a black one, nothing more).
+TEST(PbrtLights, AnEmitterReflectsWithItsMaterial) {
+  const auto radiance_from_above = [](const char* reflectance) {
+    const pbrt::built_scene b = from_text(std::string(R"(Camera "perspective"
+WorldBegin
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [ 1 1 1 ]
+  Material "diffuse" "rgb reflectance" [ )") + reflectance + R"( ]
+  Shape "trianglemesh" "point3 P" [ -50 0 -50  -50 0 50  50 0 50  50 0 -50 ] "integer indices" [ 0 1 2  0 2 3 ]
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [ 4 4 4 ]
+  Translate 0 1 0
+  Rotate 90 1 0 0
+  Shape "disk" "float radius" 0.5
+AttributeEnd
+)");
+    return test::radiance_along(b.world, ray{{0, 0.5f, 0}, {0, -1, 0}}, path_settings{1, 3}, integrator_kind::mis,
+                                sampler_kind::sobol, 16, 4096, 90, 5);
+  };
+  const test::estimate black = radiance_from_above("0 0 0"), white = radiance_from_above("1 1 1");
+  EXPECT_NEAR(black.mean, 1.0, 1e-6);  // emission only
+  const double reflected = 1.0 / std::numbers::pi * test::disk_irradiance(1.0, 0.0, 0.5, 4.0);
+  EXPECT_NEAR(white.mean, 1.0 + reflected, 6.0 * white.stderr_ + 1e-3 * reflected);
+}
+
+// A furnace: a plate at the centre of a closed cube whose 12 triangles face
+// inwards and emit L = 1 (black: they reflect nothing). The radiance the
+// plate sends up along wo after one scattering event is its BSDF's
+// directional albedo, integral of f(wo, wi) |cos theta_i| over the sphere,
+// which an estimate from eval() alone (uniform directions, a fixed seed)
+// gives independently of the BSDF's sampling and of the integrators' light
+// sampling and MIS weights (their NEE sees 12 lights, the BSDF's samples
+// meet them too).
+struct furnace_case {
+  const char* name;
+  const char* material;
+};
+
+class PbrtFurnace : public ::testing::TestWithParam<std::tuple<furnace_case, integrator_kind>> {};
+
+TEST_P(PbrtFurnace, RadianceIsTheBsdfsAlbedo) {
+  const auto& [fc, ik] = GetParam();
+  const pbrt::built_scene b = from_text(std::string(R"(Camera "perspective"
+WorldBegin
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [ 1 1 1 ]
+  Material "diffuse" "rgb reflectance" [ 0 0 0 ]
+  Translate -10 -10 -10
+  Scale 20 20 20
+  ReverseOrientation
+  Include "unit_cube.pbrt"
+AttributeEnd
+)") + fc.material + R"(
+Shape "trianglemesh" "point3 P" [ -1 0 -1  -1 0 1  1 0 1  1 0 -1 ] "integer indices" [ 0 1 2  0 2 3 ] "point2 uv" [ 0 0 0 1 1 1 1 0 ]
+)",
+                                        MCRT_SCENES_DIR "/pbrt");
+  ASSERT_EQ(b.world.emitters.size(), 12u);
+  const vec3 wo_world = glm::normalize(vec3(0.3f, 0.8f, -0.2f));
+  const ray camera{vec3(0.1f, 0.0f, 0.05f) + 5.0f * wo_world, -wo_world};
+  const test::estimate e = test::radiance_along(b.world, camera, path_settings{1, 3}, ik, sampler_kind::sobol, 32, 8192, 70, 11);
+  // The albedo from eval() of the material's BSDF at the plate, in its shading frame.
+  hit_record rec;
+  ASSERT_TRUE(b.world.hit(camera, 1e-4f, infinity, rec));
+  double albedo = 0.0;
+  const int n = 1 << 21;
+  pcg32 rng(12345, 678);
+  with_bsdf(b.world.materials[rec.material], rec, [&](const auto& bsdf) {
+    const shading_frame fr = shading_frame::from_normal_tangent(rec.shading_normal(), rec.dpdu);
+    const vec3 wo = fr.to_local(wo_world);
+    for (int i = 0; i < n; ++i) {
+      const vec3 wi = square_to_uniform_sphere(rng.uniform2());
+      albedo += double(bsdf.eval(wo, wi).r) * std::abs(wi.z) / square_to_uniform_sphere_pdf();
+    }
+  });
+  albedo /= n;
+  ASSERT_GT(albedo, 0.0);
+  // The eval() estimate's own error is below 0.3 % here (its standard error).
+  EXPECT_NEAR(e.mean, albedo, 6.0 * e.stderr_ + 0.005 * albedo) << fc.name << ": stderr " << e.stderr_;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Materials, PbrtFurnace,
+    ::testing::Combine(::testing::Values(furnace_case{"rough_copper", R"(Material "conductor" "float roughness" 0.2)"},
+                                         furnace_case{"anisotropic_gold", R"(Material "conductor" "spectrum eta" "metal-Au-eta"
+    "spectrum k" "metal-Au-k" "float uroughness" 0.05 "float vroughness" 0.4)"},
+                                         furnace_case{"rough_glass", R"(Material "dielectric" "float roughness" 0.3)"},
+                                         furnace_case{"rough_glass_alpha", R"(Material "dielectric" "float eta" 1.33
+    "float roughness" 0.5 "bool remaproughness" false)"}),
+                       ::testing::Values(integrator_kind::mixture, integrator_kind::nee, integrator_kind::mis)),
+    [](const auto& info) {
+      return std::string(std::get<0>(info.param).name) + "_" + std::string(to_string(std::get<1>(info.param)));
+    });
+
+// A smooth mirror in the same furnace: the radiance is exactly the
+// conductor's Fresnel reflectance at the angle (a delta path, no noise),
+// channel by channel.
+TEST(PbrtFurnaceSmooth, MirrorGivesTheFresnelReflectance) {
+  const pbrt::built_scene b = from_text(std::string(R"(Camera "perspective"
+WorldBegin
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [ 1 1 1 ]
+  Material "diffuse" "rgb reflectance" [ 0 0 0 ]
+  Translate -10 -10 -10
+  Scale 20 20 20
+  ReverseOrientation
+  Include "unit_cube.pbrt"
+AttributeEnd
+Material "conductor" "rgb eta" [ 0.2 0.9 1.1 ] "rgb k" [ 3.9 2.4 2.2 ]
+Shape "trianglemesh" "point3 P" [ -1 0 -1  -1 0 1  1 0 1  1 0 -1 ] "integer indices" [ 0 1 2  0 2 3 ]
+)"),
+                                        MCRT_SCENES_DIR "/pbrt");
+  const vec3 wo = glm::normalize(vec3(0.5f, 0.4f, 0.1f));
+  const ray camera{5.0f * wo, -wo};
+  const color expected = fresnel_complex(wo.y, color(0.2f, 0.9f, 1.1f), color(3.9f, 2.4f, 2.2f));
+  for (const integrator_kind ik : {integrator_kind::mixture, integrator_kind::nee, integrator_kind::mis}) {
+    const independent_sampler smp(3, 1);
+    auto ps = smp.start_pixel(0, 0, 1);
+    ps.start_sample(0);
+    const color c = with_integrator(ik, [&]<class I>() { return I::li(b.world, camera, ps, path_settings{1, 3}); });
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(c[k], expected[k], 1e-5f) << to_string(ik) << " channel " << k;
+  }
+}
+
+// The Cornell box of scenes/pbrt/cornell_rect.pbrt and of
+// scenes/cornell_rect.json render the same image (up to noise): camera,
+// mirror, walls, boxes, light and materials all agree.
+TEST(PbrtCornell, SameImageAsTheJsonScene) {
+  const cli::loaded_scene a = cli::load_scene(std::string(MCRT_SCENES_DIR) + "/cornell_rect.json");
+  const cli::loaded_scene b = cli::load_scene(std::string(MCRT_SCENES_DIR) + "/pbrt/cornell_rect.pbrt");
+  EXPECT_EQ(b.cam.width, 600);
+  EXPECT_EQ(b.spp, 100);
+  EXPECT_EQ(b.max_depth, 50);
+  EXPECT_EQ(b.filter, "box");
+  EXPECT_TRUE(b.world.accelerated());
+  render_settings rs;
+  rs.width = rs.height = 32;
+  rs.spp = 1024;
+  rs.max_depth = 50;
+  rs.integrator = integrator_kind::mis;
+  const image ia = render(a.world, a.make_camera(rs.width, rs.height), rs).img;
+  rs.seed = 1;
+  const image ib = render(b.world, b.make_camera(rs.width, rs.height), rs).img;
+  // 4 x 4 blocks of 8 x 8 pixels (65536 samples each: about 0.5 % noise
+  // in the darker blocks), within 4 %, and the whole image within 1 %.
+  double total_a = 0, total_b = 0;
+  for (int by = 0; by < 4; ++by)
+    for (int bx = 0; bx < 4; ++bx) {
+      glm::dvec3 sa(0.0), sb(0.0);
+      for (int y = 8 * by; y < 8 * by + 8; ++y)
+        for (int x = 8 * bx; x < 8 * bx + 8; ++x) {
+          sa += glm::dvec3(ia.at(x, y));
+          sb += glm::dvec3(ib.at(x, y));
+        }
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(sb[c], sa[c], 0.04 * sa[c] + 1e-3) << "block (" << bx << ", " << by << ") channel " << c;
+      total_a += sa.x + sa.y + sa.z;
+      total_b += sb.x + sb.y + sb.z;
+    }
+  EXPECT_NEAR(total_b, total_a, 0.01 * total_a);
+}
+
+// Each refusal is one line: FILE:LINE: what.
+struct refusal {
+  const char* text;
+  int line;
+  const char* says;
+};
+
+class PbrtRefusal : public ::testing::TestWithParam<refusal> {};
+
+TEST_P(PbrtRefusal, NamesTheFileAndLine) {
+  const refusal& r = GetParam();
+  try {
+    from_text(r.text);
+    ADD_FAILURE() << "accepted: " << r.text;
+  } catch (const pbrt::parse_error& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    EXPECT_EQ(what.rfind("test.pbrt:" + std::to_string(r.line) + ": ", 0), 0u) << what;
+    EXPECT_NE(what.find(r.says), std::string::npos) << what;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Contract, PbrtRefusal,
+    ::testing::Values(
+        refusal{"WorldBegin\nShape \"curve\"\n", 2, "Shape \"curve\": not supported (supported: trianglemesh"},
+        refusal{"WorldBegin\nMaterial \"coateddiffuse\"\n", 2, "not supported"},
+        refusal{"WorldBegin\nLightSource \"infinite\"\n", 2, "LightSource \"infinite\": not supported"},
+        refusal{"Camera \"orthographic\"\nWorldBegin\n", 1, "Camera \"orthographic\": not supported"},
+        refusal{"Integrator \"bdpt\"\nWorldBegin\n", 1, "Integrator \"bdpt\": not supported"},
+        refusal{"Integrator \"path\" \"bool regularize\" true\nWorldBegin\n", 1, "regularize"},
+        refusal{"Option \"bool wavefront\" true\nWorldBegin\n", 1, "Option \"bool wavefront\": not supported"},
+        refusal{"Shape \"sphere\"\n", 1, "before WorldBegin"},
+        refusal{"WorldBegin\nShape \"sphere\"\n  \"float zmin\" -0.5\n", 3, "zmin"},
+        refusal{"WorldBegin\nShape \"sphere\" \"float bogus\" 1\n", 2, "\"float bogus\" is not supported"},
+        refusal{"WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n  \"integer indices\" [0 1 3]\n", 3,
+                "index out of range"},
+        refusal{"WorldBegin\nNamedMaterial \"nothing\"\n", 2, "no material named \"nothing\""},
+        refusal{"WorldBegin\nShape \"plymesh\" \"string filename\" \"missing.ply\"\n", 2, "missing.ply"},
+        refusal{"WorldBegin\nScale 1 2 1\nShape \"sphere\"\n", 3, "not a similarity"},
+        refusal{"WorldBegin\nAreaLightSource \"diffuse\" \"spectrum L\" \"metal-Cu-eta\"\n", 2, "metal-Cu-eta"},
+        refusal{"WorldBegin\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n", 2, "MakeNamedMedium"},
+        refusal{"WorldBegin\nShape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 1]\n", 2, "not planar"},
+        refusal{"Film \"rgb\" \"float iso\" 400\nWorldBegin\n", 1, "iso"}));
+
+#ifdef MCRT_EXE
+// The executable: exit status 2, one line on stderr, no output written.
+TEST(PbrtCli, BadFileExitsWithTwoAndWritesNothing) {
+  const fs::path dir = scratch("cli");
+  {
+    std::ofstream f(dir / "bad.pbrt");
+    f << "Camera \"perspective\"\nWorldBegin\nShape \"curve\"\n";
+  }
+  const fs::path out = dir / "out.exr", err = dir / "err.txt";
+  const std::string cmd = std::string(MCRT_EXE) + " render " + (dir / "bad.pbrt").string() + " -o " + out.string() +
+                          " --quiet 2> " + err.string();
+  const int status = std::system(cmd.c_str());
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_FALSE(fs::exists(out));
+  std::ifstream e(err);
+  std::string line, rest;
+  std::getline(e, line);
+  EXPECT_FALSE(std::getline(e, rest)) << "more than one line: " << rest;
+  EXPECT_NE(line.find("bad.pbrt:3: Shape \"curve\": not supported"), std::string::npos) << line;
+}
+
+// A pbrt file renders: its Film's resolution and filename, overridden by
+// the command line.
+TEST(PbrtCli, RendersTheShippedCornellBox) {
+  const fs::path dir = scratch("cli_render");
+  const fs::path out = dir / "cb.exr";
+  const std::string cmd = std::string(MCRT_EXE) + " render " + MCRT_SCENES_DIR + "/pbrt/cornell_rect.pbrt --width 16 --height 12 --spp 4 -o " +
+                          out.string() + " --quiet";
+  EXPECT_EQ(std::system(cmd.c_str()), 0);
+  EXPECT_TRUE(fs::exists(out));
+}
+#endif
+
+}  // namespace
