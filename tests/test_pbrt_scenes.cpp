@@ -15,6 +15,7 @@
 
 #include "pbrt/builder.hpp"
 #include "scene_loader.hpp"
+#include "texture_io.hpp"
 #include "support/lambert.hpp"
 #include "support/radiance_estimate.hpp"
 
@@ -35,7 +36,9 @@ fs::path scratch(const std::string& name) {
 pbrt::built_scene from_text(const std::string& text, const std::string& dir = "") {
   pbrt::parse_options po;
   po.search_directory = dir;
-  return pbrt::build_scene(pbrt::parse_text(text, "test.pbrt", po), dir);
+  pbrt::build_options bo;
+  bo.decode_image = cli::decode_texture_image;
+  return pbrt::build_scene(pbrt::parse_text(text, "test.pbrt", po), dir, bo);
 }
 
 // A 10 x 10 floor at y = 0 of albedo 0.5, then the scene's lights. Rays
@@ -229,6 +232,67 @@ AttributeEnd
 INSTANTIATE_TEST_SUITE_P(All, PbrtFloor, ::testing::Values(integrator_kind::mixture, integrator_kind::nee, integrator_kind::mis),
                          integrator_name);
 
+// A textured floor: an 8-bit image (2 x 2 texels, sRGB-encoded, in a PPM
+// file) as the reflectance, looked up bilinearly with v flipped (pbrt-v4's
+// t = 1 - v), under a disk light; and a checkerboard of two constants. The
+// radiance at a floor point is the texture's value there times E / pi.
+TEST(PbrtTextures, ImageAndCheckerboardReflectance) {
+  const fs::path dir = scratch("textures");
+  {
+    // Row 0 (the image's top) = texels (0, 0), (1, 0).
+    std::ofstream ppm(dir / "tex.ppm", std::ios::binary);
+    const unsigned char px[12] = {255, 0, 0, 0, 255, 0, 0, 0, 255, 128, 128, 128};
+    ppm << "P6\n2 2\n255\n";
+    ppm.write(reinterpret_cast<const char*>(px), 12);
+  }
+  const auto srgb = [](double v) { return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4); };
+  const auto floor_with = [&](const std::string& texture) {
+    return from_text(R"(Camera "perspective"
+WorldBegin
+)" + texture + R"(
+Material "diffuse" "texture reflectance" "t"
+Shape "trianglemesh" "point3 P" [ 0 0 0  1 0 0  1 0 1  0 0 1 ] "integer indices" [ 0 1 2  0 2 3 ]
+    "point2 uv" [ 0 0  1 0  1 1  0 1 ]
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [ 4 4 4 ]
+  Translate 0.5 1 0.5
+  Rotate 90 1 0 0
+  Shape "disk" "float radius" 0.3
+AttributeEnd
+)",
+                     dir.string());
+  };
+  const auto radiance = [](const pbrt::built_scene& b, float x, float z) {
+    return test::radiance_along(b.world, ray{{x, 0.5f, z}, {0, -1, 0}}, path_settings{1, 3}, integrator_kind::mis,
+                                sampler_kind::sobol, 16, 2048, 80, 3);
+  };
+  {
+    const pbrt::built_scene b = floor_with(R"(Texture "t" "spectrum" "imagemap" "string filename" "tex.ppm")");
+    // uv = (x, z) on this floor; texel centres at u, t = 0.25, 0.75.
+    // (x, z) = (0.25, 0.75): s = 0.25, t = 1 - 0.75 = 0.25: texel (0, 0), red.
+    const double e = test::disk_irradiance(1.0, std::hypot(0.25, 0.25), 0.3, 4.0) / std::numbers::pi;
+    const test::estimate red = radiance(b, 0.25f, 0.75f);
+    EXPECT_NEAR(red.mean, srgb(1.0) * e, 6 * red.stderr_ + 1e-3 * e);
+    // (0.75, 0.25): s = 0.75, t = 0.75: texel (1, 1), grey 128.
+    const test::estimate grey = radiance(b, 0.75f, 0.25f);
+    EXPECT_NEAR(grey.mean, srgb(128.0 / 255.0) * e, 6 * grey.stderr_ + 1e-3 * e);
+    // (0.5, 0.5): the mean of the four texels' red channels.
+    const double e0 = test::disk_irradiance(1.0, 0.0, 0.3, 4.0) / std::numbers::pi;
+    const test::estimate mid = radiance(b, 0.5f, 0.5f);
+    EXPECT_NEAR(mid.mean, 0.25 * (srgb(1.0) + srgb(128.0 / 255.0)) * e0, 6 * mid.stderr_ + 1e-3 * e0);
+  }
+  {
+    const pbrt::built_scene b = floor_with(R"(Texture "t" "spectrum" "checkerboard" "float uscale" 4 "float vscale" 4
+    "rgb tex1" [ 0.8 0.8 0.8 ] "rgb tex2" [ 0.1 0.1 0.1 ])");
+    // (0.1, 0.1): s = t = 0.4, floor 0 + 0: even, tex1; (0.35, 0.1): s = 1.4: odd, tex2.
+    const double e1 = test::disk_irradiance(1.0, std::hypot(0.4, 0.4), 0.3, 4.0) / std::numbers::pi;
+    const double e2 = test::disk_irradiance(1.0, std::hypot(0.15, 0.4), 0.3, 4.0) / std::numbers::pi;
+    const test::estimate a = radiance(b, 0.1f, 0.1f), c = radiance(b, 0.35f, 0.1f);
+    EXPECT_NEAR(a.mean, 0.8 * e1, 6 * a.stderr_ + 1e-3 * e1);
+    EXPECT_NEAR(c.mean, 0.1 * e2, 6 * c.stderr_ + 1e-3 * e2);
+  }
+}
+
 // A light's emitting material reflects with the shape's own material: a
 // white diffuse emitter lit by another light sends back more than its
 // emission (a black one, nothing more).
@@ -393,6 +457,41 @@ TEST(PbrtCornell, SameImageAsTheJsonScene) {
   EXPECT_NEAR(total_b, total_a, 0.01 * total_a);
 }
 
+// The shipped feature scene reads completely: its meshes from the three
+// kinds of PLY file, its textures, materials and lights, and it renders
+// finite radiance everywhere.
+TEST(PbrtFeatures, TheFeatureSceneLoadsAndRenders) {
+  const cli::loaded_scene ls = cli::load_scene(std::string(MCRT_SCENES_DIR) + "/pbrt/features/features.pbrt");
+  EXPECT_TRUE(ls.world.accelerated());
+  EXPECT_EQ(ls.file_lights.size(), 3u);       // the panel's two triangles and the disk
+  EXPECT_EQ(ls.world.emitters.size(), 5u);    // the panel two-sided: each triangle twice
+  EXPECT_EQ(ls.filter, "gaussian");           // pbrt-v4's default
+  EXPECT_EQ(ls.spp, 64);
+  EXPECT_EQ(ls.max_depth, 8);
+  int textured = 0, conductors = 0, dielectrics = 0;
+  for (const material& m : ls.world.materials) {
+    textured += std::holds_alternative<textured_diffuse>(m);
+    conductors += std::holds_alternative<conductor_material>(m);
+    dielectrics += std::holds_alternative<dielectric_material>(m);
+  }
+  EXPECT_EQ(textured, 2);
+  EXPECT_EQ(conductors, 2);
+  EXPECT_EQ(dielectrics, 1);
+  const auto& tris = std::get<std::vector<object<triangle>>>(ls.world.objects);
+  EXPECT_GT(tris.size(), 1280u + 2 * 48 * 24);  // the icosphere's and the torus's triangles, at least
+  render_settings rs;
+  rs.width = 24;
+  rs.height = 16;
+  rs.spp = 4;
+  rs.max_depth = 8;
+  rs.filter = pixel_filter::gaussian();
+  const render_result r = render(ls.world, ls.make_camera(rs.width, rs.height), rs);
+  EXPECT_EQ(r.nonfinite_samples, 0u);
+  double sum = 0.0;
+  for (const color& c : r.img.pixels) sum += c.r + c.g + c.b;
+  EXPECT_GT(sum, 0.0);
+}
+
 // Each refusal is one line: FILE:LINE: what.
 struct refusal {
   const char* text;
@@ -436,7 +535,12 @@ INSTANTIATE_TEST_SUITE_P(
         refusal{"WorldBegin\nAreaLightSource \"diffuse\" \"spectrum L\" \"metal-Cu-eta\"\n", 2, "metal-Cu-eta"},
         refusal{"WorldBegin\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n", 2, "MakeNamedMedium"},
         refusal{"WorldBegin\nShape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 1]\n", 2, "not planar"},
-        refusal{"Film \"rgb\" \"float iso\" 400\nWorldBegin\n", 1, "iso"}));
+        refusal{"Film \"rgb\" \"float iso\" 400\nWorldBegin\n", 1, "iso"},
+        refusal{"WorldBegin\nTexture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"none.png\"\n", 2, "none.png"},
+        refusal{"WorldBegin\nMaterial \"diffuse\" \"texture reflectance\" \"nothing\"\n", 2, "no texture \"nothing\""},
+        refusal{"WorldBegin\nMaterial \"conductor\" \"rgb reflectance\" [0.9 0.9 0.9] \"rgb eta\" [1 1 1]\n", 2,
+                "both reflectance and eta"},
+        refusal{"WorldBegin\nAreaLightSource \"diffuse\" \"bool twosided\" true\nShape \"sphere\"\n", 3, "two-sided sphere"}));
 
 #ifdef MCRT_EXE
 // The executable: exit status 2, one line on stderr, no output written.
