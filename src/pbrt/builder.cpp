@@ -17,6 +17,10 @@ namespace fs = std::filesystem;
 
 std::string quoted(const std::string& s) { return "\"" + s + "\""; }
 
+// The command line's limits (docs/cli.md), for what a file asks for.
+constexpr int max_samples_per_pixel = 1 << 20;
+constexpr int max_path_depth = 100000;
+
 std::string join_names(const std::vector<std::string>& names) {
   std::string out;
   for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
@@ -377,6 +381,8 @@ class builder {
       out_.sampler = "stratified";
       const int x = p.integer("xsamples", 4), y = p.integer("ysamples", 4);
       if (x < 1 || y < 1) p.fail("xsamples and ysamples must be >= 1");
+      if (static_cast<long long>(x) * y > max_samples_per_pixel)
+        p.fail("xsamples x ysamples must be at most " + std::to_string(max_samples_per_pixel));
       out_.spp = x * y;
       p.accept_any("jitter");  // jittered or not: the expected image is the same
     } else if (t == "sobol" || t == "zsobol" || t == "paddedsobol" || t == "halton" || t == "pmj02bn") {
@@ -388,7 +394,8 @@ class builder {
                         ": not supported (supported: independent, stratified, sobol, zsobol, paddedsobol, halton, pmj02bn)");
     }
     p.accept_any("seed");
-    if (out_.spp < 1) p.fail("the sample count must be >= 1");
+    if (out_.spp < 1 || out_.spp > max_samples_per_pixel)
+      p.fail("the sample count must be in [1, " + std::to_string(max_samples_per_pixel) + "]");
     p.finish();
   }
 
@@ -397,7 +404,8 @@ class builder {
       refuse(d.loc, "Integrator " + quoted(d.type) + ": not supported (supported: path, volpath)");
     params p(d);
     out_.max_depth = p.integer("maxdepth", 5);
-    if (out_.max_depth < 0) p.fail("maxdepth must be >= 0");
+    if (out_.max_depth < 0 || out_.max_depth > max_path_depth)
+      p.fail("maxdepth must be in [0, " + std::to_string(max_path_depth) + "]");
     if (p.boolean("regularize", false)) p.fail(*p.find("regularize"), "true is not supported");
     if (const auto ls = p.string("lightsampler")) {
       if (*ls == "uniform")
