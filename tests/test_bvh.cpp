@@ -15,6 +15,7 @@
 #include <memory>
 
 #include "mcrt/accel/bvh.hpp"
+#include "mcrt/render/scene.hpp"
 #include "mcrt/core/rng.hpp"
 #include "mcrt/geometry/triangle_mesh.hpp"
 #include "mcrt/sampling/warp.hpp"
@@ -189,4 +190,57 @@ TEST(Bvh, TraversalTestsFewPrimitivesPerRay) {
   const double per_ray = double(tests) / rays;
   std::printf("primitives tested per ray: %.1f of %zu\n", per_ray, s.a.size());
   EXPECT_LT(per_ray, 200.0);
+}
+
+// The scene's accelerated path (build_accelerator: the hierarchy, with each
+// triangle's vertices copied beside its entry and surface_at filled from the
+// test's barycentrics) against the general one, the per-type lists: for
+// random scenes of every list shape, each ray gives the same hit or miss,
+// the same t, point, normal, side, material and uv.
+TEST(SceneAccelerator, HitsAreThoseOfTheLists) {
+  mcrt::pcg32 rng(77, 3);
+  int hits = 0;
+  for (int s = 0; s < 40; ++s) {
+    mcrt::scene sc;
+    for (int m = 0; m < 4; ++m) sc.materials.push_back(mcrt::lambertian{});
+    auto mesh = std::make_shared<mcrt::triangle_mesh>();
+    const auto r3 = [&] { return mcrt::vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 4.0f - 2.0f; };
+    for (int i = 0; i < 30; ++i) {
+      const auto k = static_cast<std::uint32_t>(mesh->p.size());
+      const mcrt::vec3 c = r3();
+      for (int v = 0; v < 3; ++v) mesh->p.push_back(c + 0.4f * r3()), mesh->uv.push_back({rng.uniform(), rng.uniform()});
+      mesh->indices.insert(mesh->indices.end(), {k, k + 1, k + 2});
+    }
+    for (const mcrt::triangle& t : mcrt::triangles_of(mesh)) sc.add(t, 0);
+    for (int i = 0; i < 4; ++i) {
+      sc.add(mcrt::sphere{r3(), 0.1f + 0.3f * rng.uniform()}, 1);
+      sc.add(mcrt::rect::make(r3(), 0.8f * mcrt::vec3(1, 0.2f, 0), 0.6f * mcrt::vec3(-0.2f, 1, 0.3f)), 2);
+      sc.add(mcrt::ellipse::make(r3(), {0.3f, 0, 0}, {0, 0.2f, 0.1f}), 3);
+    }
+    mcrt::box b;
+    b.lo = r3() * 0.2f;
+    b.hi = b.lo + 0.5f;
+    b.xf = mcrt::rigid_y::make(30.0f, r3());
+    sc.add(b, 1);
+    const mcrt::scene lists = sc;
+    sc.build_accelerator();
+    ASSERT_TRUE(sc.accelerated());
+    ASSERT_FALSE(lists.accelerated());
+    for (int i = 0; i < 500; ++i) {
+      const mcrt::ray r{r3() * 1.5f, mcrt::square_to_uniform_sphere(rng.uniform2())};
+      mcrt::hit_record a, c;
+      const bool ha = lists.hit(r, 1e-4f, mcrt::infinity, a), hc = sc.hit(r, 1e-4f, mcrt::infinity, c);
+      ASSERT_EQ(ha, hc) << "scene " << s << " ray " << i;
+      if (!ha) continue;
+      ++hits;
+      EXPECT_EQ(a.t, c.t);
+      EXPECT_EQ(a.p, c.p);
+      EXPECT_EQ(a.n, c.n);
+      EXPECT_EQ(a.front_face, c.front_face);
+      EXPECT_EQ(a.material, c.material);
+      EXPECT_EQ(a.uv, c.uv);
+      EXPECT_EQ(a.offset, c.offset);
+    }
+  }
+  EXPECT_GT(hits, 2000);
 }
