@@ -707,31 +707,9 @@ class builder {
     const std::string& t = d.type;
     if (t == "trianglemesh") {
       triangle_mesh m;
-      const std::vector<double> P = p.numbers("P", {"point3", "point"}, 3);
-      if (P.empty()) p.fail("has no \"point3 P\"");
-      for (std::size_t i = 0; i < P.size(); i += 3) m.p.push_back(vec3(float(P[i]), float(P[i + 1]), float(P[i + 2])));
-      std::vector<double> idx = p.numbers("indices", {"integer"}, 3);
-      if (idx.empty()) {
-        if (m.p.size() != 3) p.fail("has no \"integer indices\" (allowed only for a single triangle of 3 points)");
-        idx = {0, 1, 2};
-      }
-      for (const double v : idx) {
-        if (v < 0 || v >= double(m.p.size()) || v != std::floor(v))
-          p.fail(*p.find("indices"), "has an index out of range: " + std::to_string(static_cast<long long>(v)) + " (" +
-                                         std::to_string(m.p.size()) + " points)");
-        m.indices.push_back(static_cast<std::uint32_t>(v));
-      }
-      const std::vector<double> N = p.numbers("N", {"normal", "normal3"}, 3);
-      if (!N.empty()) {
-        if (N.size() != P.size()) p.fail(*p.find("N"), "must have one normal per point");
-        for (std::size_t i = 0; i < N.size(); i += 3) m.n.push_back(vec3(float(N[i]), float(N[i + 1]), float(N[i + 2])));
-      }
-      std::vector<double> uv = p.numbers("uv", {"point2", "float"}, 2);
-      if (uv.empty()) uv = p.numbers("st", {"point2", "float"}, 2);
-      if (!uv.empty()) {
-        if (uv.size() / 2 != m.p.size()) p.fail("uv must have one point per point");
-        for (std::size_t i = 0; i < uv.size(); i += 2) m.uv.push_back(vec2(float(uv[i]), float(uv[i + 1])));
-      }
+      read_points_and_normals(p, m);
+      m.indices = read_indices(p, m.p.size(), 3, "triangle");
+      if (!read_uv(p, "uv", {"point2", "float"}, m)) read_uv(p, "st", {"point2", "float"}, m);
       if (p.find("S")) p.fail(*p.find("S"), "(shading tangents) is not supported");
       p.accept_any("faceIndices");  // face numbers matter only to Ptex textures
       p.finish();
@@ -800,26 +778,55 @@ class builder {
     }
   }
 
-  void bilinear_mesh(params& p) {
+  // A mesh directive's "P" (required) and "N" (optional, one per point).
+  static void read_points_and_normals(params& p, triangle_mesh& m) {
     const std::vector<double> P = p.numbers("P", {"point3", "point"}, 3);
     if (P.empty()) p.fail("has no \"point3 P\"");
-    triangle_mesh m;
     for (std::size_t i = 0; i < P.size(); i += 3) m.p.push_back(vec3(float(P[i]), float(P[i + 1]), float(P[i + 2])));
-    std::vector<double> idx = p.numbers("indices", {"integer"}, 4);
-    if (idx.empty()) {
-      if (m.p.size() != 4) p.fail("has no \"integer indices\" (allowed only for a single patch of 4 points)");
-      idx = {0, 1, 2, 3};
-    }
     const std::vector<double> N = p.numbers("N", {"normal", "normal3"}, 3);
     if (!N.empty()) {
       if (N.size() != P.size()) p.fail(*p.find("N"), "must have one normal per point");
       for (std::size_t i = 0; i < N.size(); i += 3) m.n.push_back(vec3(float(N[i]), float(N[i + 1]), float(N[i + 2])));
     }
-    const std::vector<double> uv = p.numbers("uv", {"point2"}, 2);
-    if (!uv.empty()) {
-      if (uv.size() / 2 != m.p.size()) p.fail("uv must have one point per point");
-      for (std::size_t i = 0; i < uv.size(); i += 2) m.uv.push_back(vec2(float(uv[i]), float(uv[i + 1])));
-    } else {
+  }
+
+  // A mesh directive's "indices", `group` per face, each checked against
+  // the number of points; absent, 0 .. group - 1 for a single face of
+  // `group` points (pbrt-v4's rule).
+  static std::vector<std::uint32_t> read_indices(params& p, std::size_t points, std::size_t group, const char* face) {
+    std::vector<double> idx = p.numbers("indices", {"integer"}, group);
+    if (idx.empty()) {
+      if (points != group)
+        p.fail("has no \"integer indices\" (allowed only for a single " + std::string(face) + " of " +
+               std::to_string(group) + " points)");
+      for (std::size_t k = 0; k < group; ++k) idx.push_back(double(k));
+    }
+    std::vector<std::uint32_t> out;
+    out.reserve(idx.size());
+    for (const double v : idx) {
+      if (v < 0 || v >= double(points) || v != std::floor(v))
+        p.fail(*p.find("indices"), "has an index out of range: " + std::to_string(static_cast<long long>(v)) + " (" +
+                                       std::to_string(points) + " points)");
+      out.push_back(static_cast<std::uint32_t>(v));
+    }
+    return out;
+  }
+
+  // The texture coordinates `name`, one point per point; false where absent.
+  static bool read_uv(params& p, const char* name, std::initializer_list<const char*> types, triangle_mesh& m) {
+    const std::vector<double> uv = p.numbers(name, types, 2);
+    if (uv.empty()) return false;
+    if (uv.size() / 2 != m.p.size()) p.fail("uv must have one point per point");
+    for (std::size_t i = 0; i < uv.size(); i += 2) m.uv.push_back(vec2(float(uv[i]), float(uv[i + 1])));
+    return true;
+  }
+
+  void bilinear_mesh(params& p) {
+    triangle_mesh m;
+    read_points_and_normals(p, m);
+    const std::vector<std::uint32_t> idx = read_indices(p, m.p.size(), 4, "patch");
+    const bool has_uv = read_uv(p, "uv", {"point2"}, m);
+    if (!has_uv) {
       // pbrt-v4's patch parameterisation: p00 (0,0), p10 (1,0), p01 (0,1),
       // p11 (1,1); on a planar parallelogram the triangles interpolate it
       // exactly. Points shared by patches with different corners get the
@@ -830,13 +837,7 @@ class builder {
     p.accept_any("faceIndices");
     p.finish();
     for (std::size_t i = 0; i < idx.size(); i += 4) {
-      std::array<std::uint32_t, 4> v;
-      for (int k = 0; k < 4; ++k) {
-        const double x = idx[i + std::size_t(k)];
-        if (x < 0 || x >= double(m.p.size()) || x != std::floor(x))
-          p.fail(*p.find("indices"), "has an index out of range: " + std::to_string(static_cast<long long>(x)));
-        v[std::size_t(k)] = static_cast<std::uint32_t>(x);
-      }
+      const std::array<std::uint32_t, 4> v{idx[i], idx[i + 1], idx[i + 2], idx[i + 3]};
       // Patch p00 p10 p01 p11 -> the quad p00 p10 p11 p01 -> triangles
       // (p00, p10, p11) and (p00, p11, p01); their normal is the patch's
       // cross(p10 - p00, p01 - p00) where the patch is planar and convex.
@@ -847,7 +848,7 @@ class builder {
         p.fail("patch " + std::to_string(i / 4) + " is not planar (bilinear patches are supported when planar)");
       if (glm::dot(glm::cross(b - a, c - a), n) <= 0.0f || glm::dot(glm::cross(c - a, e - a), n) <= 0.0f)
         p.fail("patch " + std::to_string(i / 4) + " is not convex");
-      if (uv.empty()) {
+      if (!has_uv) {
         m.uv[v[0]] = {0, 0};
         m.uv[v[1]] = {1, 0};
         m.uv[v[2]] = {0, 1};
