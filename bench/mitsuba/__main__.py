@@ -1,4 +1,5 @@
 """python -m bench.mitsuba [SCENE.json ...] [options]   (from the repository root)
+   python -m bench.mitsuba --pbrt FILE.pbrt [--pbrt ...] [--size W --spp N --max-depth D]
 
 Compares mcrt's efficiency, 1 / (MSE x render seconds), with Mitsuba 3's path
 tracer on the same scenes. Runs itself with .venv/bin/python (creating .venv
@@ -60,7 +61,22 @@ def parse(argv):
     p.add_argument("--threads", type=int, default=2, help="threads of both renderers (default 2)")
     p.add_argument("--max-depth", type=int, help="mcrt max depth (default: the scene's); Mitsuba gets it + 1")
     p.add_argument("--xml", action="store_true", help="only write the Mitsuba XML of the scenes to OUT/xml")
+    g = p.add_argument_group("pbrt-v4 files (side-by-side comparison, see README.md)")
+    g.add_argument("--pbrt", action="append", metavar="FILE.pbrt",
+                   help="render this pbrt-v4 file with mcrt and, translated, with Mitsuba; repeatable. "
+                        "--size, --spp (one value), --max-depth (pbrt's maxdepth) override the file")
+    g.add_argument("--named-spectra", choices=("mitsuba", "pbrt"), default="mitsuba",
+                   help="named metals: Mitsuba's presets (default) or pbrt-v4's tables as mcrt converts them")
+    g.add_argument("--variant", default="scalar_rgb", help="Mitsuba variant (default %(default)s)")
+    g.add_argument("--reference", help="an EXR whose mean both images are compared with (e.g. TungstenRender.exr)")
+    g.add_argument("--png-width", type=int, default=256, help="width of each of the PNG's three panels")
     a = p.parse_args(argv)
+    if a.pbrt:
+        a.spp_given = a.spp is not None
+        a.spp = [int(x) for x in (a.spp or "16").split(",")]
+        a.out = Path(a.out).resolve() if a.out else ROOT / "build" / "mitsuba-compare" / "pbrt"
+        a.mcrt = Path(a.mcrt).resolve()
+        return a
     q = a.quick
     a.spp = [int(x) for x in (a.spp or ("4,16" if q else "16,64,256")).split(",")]
     a.seeds = a.seeds or (2 if q else 3)
@@ -85,5 +101,10 @@ def parse(argv):
 
 if __name__ == "__main__":
     bootstrap()
-    from . import run
-    run.main(parse(sys.argv[1:]), sys.argv[1:])
+    args = parse(sys.argv[1:])
+    if args.pbrt:
+        from . import pbrt_compare
+        pbrt_compare.main(args)
+    else:
+        from . import run
+        run.main(args, sys.argv[1:])

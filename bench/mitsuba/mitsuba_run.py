@@ -21,10 +21,11 @@ VARIANT = "scalar_rgb"
 
 
 class Mitsuba:
-    def __init__(self, threads):
+    def __init__(self, threads, variant=VARIANT):
         import drjit as dr
         import mitsuba as mi
-        mi.set_variant(VARIANT)
+        mi.set_variant(variant)
+        self.variant = variant
         mi.set_log_level(mi.LogLevel.Warn)  # no progress bar in timed renders
         dr.set_thread_count(threads)
         self.mi, self.dr = mi, dr

@@ -66,6 +66,8 @@ def _to_dict_value(v, mi):
         return {"type": "ref", "id": val}
     if kind == "matrix":
         return mi.ScalarTransform4f(val.tolist())
+    if kind == "matrix3":  # a texture's to_uv
+        return mi.ScalarTransform3f(val.tolist())
     if kind == "lookat":
         o, t, u = val
         return mi.ScalarTransform4f().look_at(origin=o, target=t, up=u)
@@ -86,14 +88,21 @@ def _num(x):
     return repr(float(x))
 
 
-def _xml_node(tag, node, id_, ind):
+PLUGIN_TAGS = {"sampler", "film", "rfilter", "emitter", "bsdf"}
+
+
+def _xml_node(tag, node, id_, ind, name=None):
     pad = "    " * ind
-    lines = [f'{pad}<{tag} type="{node["type"]}"' + (f' id={quoteattr(id_)}>' if id_ else ">")]
+    lines = [f'{pad}<{tag} type="{node["type"]}"' + (f' name={quoteattr(name)}' if name else "")
+             + (f' id={quoteattr(id_)}>' if id_ else ">")]
     for k, v in node.items():
         if k == "type":
             continue
-        if isinstance(v, dict):  # nested plugin: sampler, film, rfilter, emitter, bsdf
-            lines += _xml_node(k, v, None, ind + 1)
+        if isinstance(v, dict):  # nested plugin: sampler, film, rfilter, emitter, bsdf, or a texture
+            if k in PLUGIN_TAGS:
+                lines += _xml_node(k, v, None, ind + 1)
+            else:
+                lines += _xml_node("texture", v, None, ind + 1, name=k)
             continue
         kind, val = v
         p = pad + "    "
@@ -101,7 +110,7 @@ def _xml_node(tag, node, id_, ind):
             lines.append(f'{p}<rgb name="{k}" value="{", ".join(_num(x) for x in val)}"/>')
         elif kind == "ref":
             lines.append(f'{p}<ref id={quoteattr(val)}/>')
-        elif kind == "matrix":
+        elif kind in ("matrix", "matrix3"):
             vals = " ".join(_num(x) for x in val.reshape(-1))
             lines.append(f'{p}<transform name="{k}"><matrix value="{vals}"/></transform>')
         elif kind == "lookat":
