@@ -150,7 +150,8 @@ vec3 point_in(const aabb& b, pcg32& rng) {
 struct mcrt_bare {
   bvh tree;
   std::vector<std::uint32_t> triangle_of;       // leaf order -> the mesh's triangle
-  std::vector<std::array<vec3, 3>> verts;       // the vertices in leaf order
+  // the vertices in leaf order (in huge pages where the system has them)
+  std::vector<std::array<vec3, 3>, large_array_allocator<std::array<vec3, 3>>> verts;
 
   explicit mcrt_bare(const triangle_mesh& m) {
     const std::size_t n = m.triangle_count();
@@ -372,8 +373,14 @@ int main(int argc, char** argv) {
                   b_eall[c].back());
     std::printf("\n");
   }
-  std::printf("mcrt bvh: %zu nodes (%zu bytes)\n", bare->tree.nodes().size(),
-              bare->tree.nodes().size() * sizeof(bvh::node));
+  {
+    std::size_t leaves = 0, prims = 0;
+    for (const bvh::node& nd : bare->tree.nodes()) leaves += nd.count > 0, prims += nd.count;
+    std::printf("mcrt bvh: binary tree %zu nodes (%zu bytes), %zu leaves (%.2f triangles each); traversal's 4-wide "
+                "tree %zu nodes (%zu bytes)\n",
+                bare->tree.nodes().size(), bare->tree.nodes().size() * sizeof(bvh::node), leaves,
+                double(prims) / double(leaves), bare->tree.wide_node_count(), bare->tree.wide_node_count() * 128);
+  }
 
   // ---- cross-check (untimed): mcrt bare and scene against Embree MEDIUM and HIGH
   bool ok = true;

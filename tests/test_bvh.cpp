@@ -6,7 +6,8 @@
 // scene's box; and the tree's invariants: its order is a permutation, every
 // node's box holds its children's and its primitives', leaves hold at most
 // max_leaf_size, its depth fits the traversal's stack, also for degenerate
-// inputs (every primitive in one place, coordinates spread over 30 decades).
+// inputs (every primitive in one place, coordinates spread over 30 decades);
+// and a tree whose traversal nodes take huge-page storage.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -190,6 +191,23 @@ TEST(Bvh, TraversalTestsFewPrimitivesPerRay) {
   const double per_ray = double(tests) / rays;
   std::printf("primitives tested per ray: %.1f of %zu\n", per_ray, s.a.size());
   EXPECT_LT(per_ray, 200.0);
+}
+
+// A tree whose traversal nodes pass 2 MiB (large_array_allocator's huge-page
+// storage on Linux) traverses as brute force tests; that storage itself is
+// aligned and keeps what is written to it.
+TEST(Bvh, LargeTreeInHugePageStorage) {
+  pcg32 rng(9, 10);
+  const soup s = random_soup(rng, 60000, 100.0f, 1.5f);
+  const bvh tree(s.bounds());
+  ASSERT_GT(tree.wide_node_count() * 128, std::size_t(2) << 20);
+  expect_same_as_brute_force(s, tree, rng, 200, 100.0f, 0.05, 0.05);
+  std::vector<std::uint32_t, large_array_allocator<std::uint32_t>> v(std::size_t(3) << 20);
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = static_cast<std::uint32_t>(i * 7);
+  v.resize(v.size() + 5, 1);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(v.data()) % 64, 0u);
+  for (std::size_t i = 0; i < (std::size_t(3) << 20); i += 4099) ASSERT_EQ(v[i], static_cast<std::uint32_t>(i * 7));
+  EXPECT_EQ(v.back(), 1u);
 }
 
 // The scene's accelerated path (build_accelerator: the hierarchy, with each

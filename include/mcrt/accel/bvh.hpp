@@ -5,25 +5,85 @@
 // SAH-based bounding volume hierarchies"; pbrt-v4's BVHAggregate with 12
 // buckets), stored as compact nodes in depth-first order (32 bytes: the box,
 // the second child's or the first primitive's index, a count and the split
-// axis; Pharr et al., "Physically Based Rendering", 4th ed., sec. 7.3.4),
-// and traversed front to back (the near child first by the ray's direction
-// along the node's split axis), with an early exit for shadow rays.
+// axis; Pharr et al., "Physically Based Rendering", 4th ed., sec. 7.3.4).
+// For traversal that binary tree is collapsed into a 4-wide one (Dammertz,
+// Hanika & Keller 2008, "Shallow bounding volume hierarchies for fast SIMD
+// ray tracing of incoherent rays"; Wald, Benthin & Boulos 2008, "Getting rid
+// of packets"; as Embree's BVH4): a 128-byte node holds its four children's
+// boxes side by side, a structure of arrays tested as one 4-wide vector. A
+// ray visits the children it hits nearest first (by where it enters their
+// boxes), asks the memory ahead for the nodes it puts aside, and skips, when
+// it comes back to them, those it enters beyond its closest hit so far;
+// shadow rays stop at the first hit. On incoherent rays through a large
+// mesh the traversal waits on memory, for nodes and primitives alike: the
+// wide tree reads a third of the binary tree's nodes, and its nodes live in
+// huge pages where the system offers them (large_array_allocator).
 //
 // The hierarchy knows its primitives only through their bounds, at build
 // time, and through a callback at traversal: it holds their order, so a
 // primitive is named by its index in the caller's array.
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
+#include <new>
 #include <vector>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #include "mcrt/core/math.hpp"
 #include "mcrt/core/ray.hpp"
 #include "mcrt/geometry/aabb.hpp"
 
 namespace mcrt {
+
+// Storage for a large array that rays read at random (the wide tree's nodes;
+// also fit for a caller's primitives in the tree's order): on Linux, from
+// 2 MiB on, aligned to 2 MiB and advised as transparent huge pages
+// (madvise MADV_HUGEPAGE; honoured where the system's setting is "madvise"
+// or "always"), so that random reads miss the TLB far less, as Embree's own
+// allocator does; elsewhere, and below that size, operator new.
+template <class T>
+struct large_array_allocator {
+  using value_type = T;
+  static constexpr std::size_t huge_page = std::size_t(2) << 20;
+  static constexpr std::size_t alignment = alignof(T) > alignof(std::max_align_t) ? alignof(T) : alignof(std::max_align_t);
+
+  large_array_allocator() = default;
+  template <class U>
+  large_array_allocator(const large_array_allocator<U>&) {}
+
+  T* allocate(std::size_t n) {
+    const std::size_t bytes = n * sizeof(T);
+#if defined(__linux__)
+    if (bytes >= huge_page) {
+      void* p = std::aligned_alloc(huge_page, (bytes + huge_page - 1) / huge_page * huge_page);
+      if (!p) throw std::bad_alloc();
+      madvise(p, bytes, MADV_HUGEPAGE);
+      return static_cast<T*>(p);
+    }
+#endif
+    return static_cast<T*>(::operator new(bytes, std::align_val_t(alignment)));
+  }
+  void deallocate(T* p, std::size_t n) {
+#if defined(__linux__)
+    if (n * sizeof(T) >= huge_page) return std::free(p);
+#endif
+    (void)n;
+    ::operator delete(p, std::align_val_t(alignment));
+  }
+  template <class U>
+  bool operator==(const large_array_allocator<U>&) const {
+    return true;
+  }
+};
 
 class bvh {
  public:
@@ -51,18 +111,23 @@ class bvh {
     for (std::size_t i = 0; i < bounds.size(); ++i) centroids[i] = bounds[i].centroid();
     nodes_.reserve(2 * bounds.size());
     build(bounds, centroids, 0, static_cast<std::uint32_t>(bounds.size()), 0);
+    collapse(bounds);
   }
 
   bool empty() const { return nodes_.empty(); }
+  // The binary tree as built (the traversal reads the wide tree made of it).
   const std::vector<node>& nodes() const { return nodes_; }
   // The primitives in the order the leaves reference them.
   const std::vector<std::uint32_t>& order() const { return order_; }
+  // The nodes of the traversal's 4-wide tree (128 bytes each).
+  std::size_t wide_node_count() const { return wide_.size(); }
 
   // For a caller that has stored its primitives in order() (leaf by leaf,
   // so that a leaf's primitives are adjacent in memory): from then on the
   // traversal names a primitive by its place in that order.
   void renumber_in_order() {
     for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = static_cast<std::uint32_t>(i);
+    in_order_ = true;
   }
 
   // The closest hit in (tmin, tmax): hit(i, tmin, tmax) tests primitive i
@@ -91,8 +156,23 @@ class bvh {
   }
 
  private:
+  // A node of the traversal's 4-wide tree: its children's boxes (lo x, y, z,
+  // then hi x, y, z, each for the four children; an unused child's box is
+  // empty, lo = +inf and hi = -inf, which no ray enters), and for each child
+  // a wide node's index (count 0) or a leaf's first primitive in order() and
+  // its primitive count.
+  struct alignas(64) wide_node {
+    std::array<std::array<float, 4>, 6> b;
+    std::array<std::uint32_t, 4> child;
+    std::array<std::uint8_t, 4> count;
+  };
+  static_assert(sizeof(wide_node) == 128);
+
   std::vector<node> nodes_;
+  std::vector<wide_node, large_array_allocator<wide_node>> wide_;
   std::vector<std::uint32_t> order_;
+  bool in_order_ = false;  // order_ is the identity (renumber_in_order)
+  std::vector<char> leaf_;  // while collapsing: which binary nodes become leaves
 
   static constexpr int bucket_count = 12;
   // The traversal's stack holds at most one node per level. Below this depth
@@ -100,6 +180,9 @@ class bvh {
   // primitive count (<= 32): within the stack.
   static constexpr int balanced_below_depth = 96;
   static constexpr int stack_size = 128;
+  // The wide tree is no deeper than the binary one, and a wide node pushes
+  // at most three children beyond the one the traversal goes on with.
+  static constexpr int wide_stack_size = 3 * stack_size + 4;
 
   // Builds the subtree of order_[begin, end) and returns its node's index.
   std::uint32_t build(const std::vector<aabb>& bounds, const std::vector<vec3>& centroids, std::uint32_t begin,
@@ -182,56 +265,227 @@ class bvh {
     return index;
   }
 
-  // The slab test against a node's box, with the far distance widened by
-  // 2 gamma(3) so that rounding cannot reject a box the ray grazes (PBRT
-  // 4th ed., sec. 6.8.2).
-  static bool hits_box(const node& nd, const vec3& o, const vec3& inv_d, const std::array<int, 3>& neg, float tmin,
-                       float tmax) {
-    const float* lo = &nd.lo.x;
-    const float* hi = &nd.hi.x;
-    float t0 = tmin, t1 = tmax;
-    for (int a = 0; a < 3; ++a) {
-      const float near = ((neg[static_cast<std::size_t>(a)] ? hi[a] : lo[a]) - o[a]) * inv_d[a];
-      float far = ((neg[static_cast<std::size_t>(a)] ? lo[a] : hi[a]) - o[a]) * inv_d[a];
-      far *= 1.0f + 2.0f * rounding_gamma(3);
-      t0 = near > t0 ? near : t0;  // (NaN from 0 * inf leaves t0 as it is)
-      t1 = far < t1 ? far : t1;
-      if (t0 > t1) return false;
+  // The 4-wide tree of the binary one: from the root, each wide node takes
+  // the binary subtree's nodes down to four children (opening, while fewer
+  // than four, the interior child of the largest surface area). A child
+  // becomes a leaf where it is a binary leaf, or a subtree of at most
+  // max_leaf_size primitives whose boxes would spare a ray entering it few
+  // tests: their surface areas add up to at least merge_overlap times the
+  // primitives' count times the subtree's (the tests a ray entering it makes
+  // by the surface area heuristic's odds, at least that share of them all).
+  // A mesh's neighbouring triangles are so merged, leaf by leaf adjacent in
+  // the caller's memory, and save a node's read; scattered small shapes
+  // keep their boxes.
+  static constexpr float merge_overlap = 0.5f;
+
+  void collapse(const std::vector<aabb>& bounds) {
+    wide_.clear();
+    if (nodes_.empty()) return;
+    // Each binary node's primitives (a range of order_, as the build made it
+    // depth first) and the sum of their boxes' surface areas.
+    std::vector<std::uint32_t> count(nodes_.size());
+    std::vector<float> area(nodes_.size());
+    for (std::size_t k = nodes_.size(); k-- > 0;) {
+      const node& nd = nodes_[k];
+      if (nd.count > 0) {
+        count[k] = nd.count;
+        area[k] = 0.0f;
+        for (std::uint32_t i = 0; i < nd.count; ++i) area[k] += bounds[order_[nd.offset + i]].surface_area();
+      } else {
+        count[k] = count[k + 1] + count[nd.offset];
+        area[k] = area[k + 1] + area[nd.offset];
+      }
     }
-    return true;
+    leaf_.assign(nodes_.size(), 0);
+    for (std::size_t k = 0; k < nodes_.size(); ++k) {
+      const node& nd = nodes_[k];
+      leaf_[k] = nd.count > 0 || (count[k] <= static_cast<std::uint32_t>(max_leaf_size) &&
+                                  area[k] >= merge_overlap * float(count[k]) * aabb{nd.lo, nd.hi}.surface_area());
+    }
+    wide_.reserve(nodes_.size() / 3 + 1);
+    collapse_node(0, count);
+    leaf_ = {};
+  }
+
+  // A binary node's first primitive in order_.
+  std::uint32_t first_primitive(std::uint32_t k) const {
+    while (nodes_[k].count == 0) ++k;
+    return nodes_[k].offset;
+  }
+
+  std::uint32_t collapse_node(std::uint32_t k, const std::vector<std::uint32_t>& count) {
+    std::array<std::uint32_t, 4> slot{k};
+    int n = 1;
+    if (!leaf_[k]) {
+      slot = {k + 1, nodes_[k].offset};
+      n = 2;
+    }
+    while (n < 4) {
+      int open = -1;
+      float open_area = -1.0f;
+      for (int i = 0; i < n; ++i) {
+        const node& c = nodes_[slot[static_cast<std::size_t>(i)]];
+        if (leaf_[slot[static_cast<std::size_t>(i)]]) continue;
+        const float a = aabb{c.lo, c.hi}.surface_area();
+        if (a > open_area) open = i, open_area = a;
+      }
+      if (open < 0) break;
+      const std::uint32_t c = slot[static_cast<std::size_t>(open)];
+      slot[static_cast<std::size_t>(open)] = c + 1;
+      slot[static_cast<std::size_t>(n++)] = nodes_[c].offset;
+    }
+    const auto index = static_cast<std::uint32_t>(wide_.size());
+    wide_.emplace_back();
+    for (int i = 0; i < 4; ++i) {
+      const auto u = static_cast<std::size_t>(i);
+      std::uint32_t child = 0;
+      std::uint8_t leaf_count = 0;
+      vec3 lo{infinity}, hi{-infinity};
+      if (i < n) {
+        const node& c = nodes_[slot[u]];
+        lo = c.lo;
+        hi = c.hi;
+        if (leaf_[slot[u]]) {
+          child = first_primitive(slot[u]);
+          leaf_count = static_cast<std::uint8_t>(count[slot[u]]);
+        } else {
+          child = collapse_node(slot[u], count);
+        }
+      }
+      wide_node& w = wide_[index];
+      for (int a = 0; a < 3; ++a) {
+        w.b[static_cast<std::size_t>(a)][u] = lo[a];
+        w.b[static_cast<std::size_t>(a + 3)][u] = hi[a];
+      }
+      w.child[u] = child;
+      w.count[u] = leaf_count;
+    }
+    return index;
+  }
+
+  // The slab test of a ray against a node's four boxes, with the far
+  // distance widened by 2 gamma(3) so that rounding cannot reject a box the
+  // ray grazes (PBRT 4th ed., sec. 6.8.2): bit i of the result for child i,
+  // t0[i] where the ray enters its box. A NaN distance (0 * inf, a ray in a
+  // slab's plane) leaves the interval as it is.
+  static unsigned hits_boxes(const wide_node& w, const vec3& o, const vec3& inv_d,
+                             const std::array<std::size_t, 3>& near_row, const std::array<std::size_t, 3>& far_row,
+                             float tmin, float tmax, std::array<float, 4>& t0) {
+    constexpr float widen = 1.0f + 2.0f * rounding_gamma(3);
+#if defined(__GNUC__) || defined(__clang__)
+    // Four lanes at once (GCC's and Clang's vector extensions: SSE, NEON).
+    using float4 = float __attribute__((vector_size(16)));
+    using int4 = std::int32_t __attribute__((vector_size(16)));
+    float4 lo = {tmin, tmin, tmin, tmin}, hi = {tmax, tmax, tmax, tmax};
+    for (std::size_t a = 0; a < 3; ++a) {
+      float4 near_plane, far_plane;
+      std::memcpy(&near_plane, w.b[near_row[a]].data(), sizeof(float4));
+      std::memcpy(&far_plane, w.b[far_row[a]].data(), sizeof(float4));
+      const float oa = o[static_cast<int>(a)], ia = inv_d[static_cast<int>(a)];
+      const float4 near = (near_plane - oa) * ia;
+      const float4 far = (far_plane - oa) * ia * widen;
+      const int4 n = near > lo, f = far < hi;
+      lo = reinterpret_cast<float4>((reinterpret_cast<int4>(near) & n) | (reinterpret_cast<int4>(lo) & ~n));
+      hi = reinterpret_cast<float4>((reinterpret_cast<int4>(far) & f) | (reinterpret_cast<int4>(hi) & ~f));
+    }
+    const int4 in = lo <= hi;
+    std::memcpy(t0.data(), &lo, sizeof(float4));
+    return unsigned(in[0] & 1) | unsigned(in[1] & 2) | unsigned(in[2] & 4) | unsigned(in[3] & 8);
+#else
+    std::array<float, 4> t1;
+    t0.fill(tmin);
+    t1.fill(tmax);
+    for (std::size_t a = 0; a < 3; ++a) {
+      const std::array<float, 4>&near_plane = w.b[near_row[a]], &far_plane = w.b[far_row[a]];
+      const float oa = o[static_cast<int>(a)], ia = inv_d[static_cast<int>(a)];
+      for (std::size_t i = 0; i < 4; ++i) {
+        const float near = (near_plane[i] - oa) * ia;
+        const float far = (far_plane[i] - oa) * ia * widen;
+        t0[i] = near > t0[i] ? near : t0[i];
+        t1[i] = far < t1[i] ? far : t1[i];
+      }
+    }
+    unsigned mask = 0;
+    for (std::size_t i = 0; i < 4; ++i) mask |= unsigned(t0[i] <= t1[i]) << i;
+    return mask;
+#endif
+  }
+
+  // Asks for both cache lines of a wide node ahead of its visit.
+  static void prefetch(const wide_node* w) {
+#if defined(__GNUC__) || defined(__clang__)
+    __builtin_prefetch(w);
+    __builtin_prefetch(reinterpret_cast<const char*>(w) + 64);
+#else
+    (void)w;
+#endif
   }
 
   // Visits the leaves' primitives front to back; visit(prim, tmax) may
-  // lower tmax and returns true to stop.
+  // lower tmax and returns true to stop. Each box is the slab test, with the
+  // far distance widened by 2 gamma(3) so that rounding cannot reject a box
+  // the ray grazes (PBRT 4th ed., sec. 6.8.2), for a node's four children
+  // at once.
   template <class Visit>
   bool traverse(const ray& r, float tmin, float& tmax, Visit&& visit) const {
-    if (nodes_.empty()) return false;
+    if (wide_.empty()) return false;
     const vec3 inv_d = 1.0f / r.d;
-    const std::array<int, 3> neg = {inv_d.x < 0.0f, inv_d.y < 0.0f, inv_d.z < 0.0f};
-    std::array<std::uint32_t, stack_size> stack;
-    int top = 0;
-    std::uint32_t current = 0;
-    while (true) {
-      const node& nd = nodes_[current];
-      if (hits_box(nd, r.o, inv_d, neg, tmin, tmax)) {
-        if (nd.count > 0) {
-          for (std::uint32_t i = 0; i < nd.count; ++i)
-            if (visit(order_[nd.offset + i], tmax)) return true;
-          if (top == 0) break;
-          current = stack[static_cast<std::size_t>(--top)];
-        } else if (neg[nd.axis]) {  // the second child is nearer
-          stack[static_cast<std::size_t>(top++)] = current + 1;
-          current = nd.offset;
-        } else {
-          stack[static_cast<std::size_t>(top++)] = nd.offset;
-          current = current + 1;
-        }
-      } else {
-        if (top == 0) break;
-        current = stack[static_cast<std::size_t>(--top)];
-      }
+    // The rows of a node's boxes that hold each axis's near and far planes.
+    std::array<std::size_t, 3> near_row, far_row;
+    for (int a = 0; a < 3; ++a) {
+      const bool neg = inv_d[a] < 0.0f;
+      near_row[static_cast<std::size_t>(a)] = static_cast<std::size_t>(neg ? a + 3 : a);
+      far_row[static_cast<std::size_t>(a)] = static_cast<std::size_t>(neg ? a : a + 3);
     }
-    return false;
+    struct entry {
+      std::uint32_t child;
+      std::uint32_t count;  // leaf: its primitives; 0: a wide node
+      float t;              // where the ray enters its box
+    };
+    std::array<entry, wide_stack_size> stack;
+    int top = 0;
+    entry e{0, 0, tmin};
+    while (true) {
+      if (e.count > 0) {
+        for (std::uint32_t i = 0; i < e.count; ++i)
+          if (visit(in_order_ ? e.child + i : order_[e.child + i], tmax)) return true;
+      } else {
+        const wide_node& w = wide_[e.child];
+        std::array<float, 4> t0;
+        unsigned mask = hits_boxes(w, r.o, inv_d, near_row, far_row, tmin, tmax, t0);
+        if (mask != 0) {
+          const auto child = [&](unsigned i) { return entry{w.child[i], w.count[i], t0[i]}; };
+          const auto first = static_cast<unsigned>(std::countr_zero(mask));
+          mask &= mask - 1;
+          if (mask == 0) {  // one child hit: on to it
+            e = child(first);
+            continue;
+          }
+          // Several: onto the stack, sorted so that the nearest is on top,
+          // and on to it; the others wait, their nodes asked for ahead.
+          const int base = top;
+          stack[static_cast<std::size_t>(top++)] = child(first);
+          do {
+            const entry c = child(static_cast<unsigned>(std::countr_zero(mask)));
+            mask &= mask - 1;
+            int k = top++;
+            for (; k > base && stack[static_cast<std::size_t>(k - 1)].t < c.t; --k)
+              stack[static_cast<std::size_t>(k)] = stack[static_cast<std::size_t>(k - 1)];
+            stack[static_cast<std::size_t>(k)] = c;
+          } while (mask != 0);
+          e = stack[static_cast<std::size_t>(--top)];
+          for (int k = base; k < top; ++k)
+            if (stack[static_cast<std::size_t>(k)].count == 0) prefetch(&wide_[stack[static_cast<std::size_t>(k)].child]);
+          continue;
+        }
+      }
+      // The next waiting child that the ray enters before its closest hit
+      // so far.
+      do {
+        if (top == 0) return false;
+        e = stack[static_cast<std::size_t>(--top)];
+      } while (e.t > tmax);
+    }
   }
 };
 
