@@ -376,10 +376,11 @@ int main(int argc, char** argv) {
   {
     std::size_t leaves = 0, prims = 0;
     for (const bvh::node& nd : bare->tree.nodes()) leaves += nd.count > 0, prims += nd.count;
-    std::printf("mcrt bvh: binary tree %zu nodes (%zu bytes), %zu leaves (%.2f triangles each); traversal's 4-wide "
+    std::printf("mcrt bvh: binary tree %zu nodes (%zu bytes), %zu leaves (%.2f triangles each); traversal's %d-wide "
                 "tree %zu nodes (%zu bytes)\n",
                 bare->tree.nodes().size(), bare->tree.nodes().size() * sizeof(bvh::node), leaves,
-                double(prims) / double(leaves), bare->tree.wide_node_count(), bare->tree.wide_node_count() * 128);
+                double(prims) / double(leaves), bvh::width, bare->tree.wide_node_count(),
+                bare->tree.wide_node_count() * 32 * std::size_t(bvh::width));
   }
 
   // ---- cross-check (untimed): mcrt bare and scene against Embree MEDIUM and HIGH

@@ -6,17 +6,17 @@
 // buckets), stored as compact nodes in depth-first order (32 bytes: the box,
 // the second child's or the first primitive's index, a count and the split
 // axis; Pharr et al., "Physically Based Rendering", 4th ed., sec. 7.3.4).
-// For traversal that binary tree is collapsed into a 4-wide one (Dammertz,
+// For traversal that binary tree is collapsed into an 8-wide one (Dammertz,
 // Hanika & Keller 2008, "Shallow bounding volume hierarchies for fast SIMD
 // ray tracing of incoherent rays"; Wald, Benthin & Boulos 2008, "Getting rid
-// of packets"; as Embree's BVH4): a 128-byte node holds its four children's
-// boxes side by side, a structure of arrays tested as one 4-wide vector. A
+// of packets"; as Embree's BVH8): a 256-byte node holds its eight children's
+// boxes side by side, a structure of arrays tested as one 8-wide vector. A
 // ray visits the children it hits nearest first (by where it enters their
 // boxes), asks the memory ahead for the nodes it puts aside, and skips, when
 // it comes back to them, those it enters beyond its closest hit so far;
 // shadow rays stop at the first hit. On incoherent rays through a large
 // mesh the traversal waits on memory, for nodes and primitives alike: the
-// wide tree reads a third of the binary tree's nodes, and its nodes live in
+// wide tree is a third as deep as the binary one, and its nodes live in
 // huge pages where the system offers them (large_array_allocator).
 //
 // The hierarchy knows its primitives only through their bounds, at build
@@ -119,7 +119,9 @@ class bvh {
   const std::vector<node>& nodes() const { return nodes_; }
   // The primitives in the order the leaves reference them.
   const std::vector<std::uint32_t>& order() const { return order_; }
-  // The nodes of the traversal's 4-wide tree (128 bytes each).
+  // Children of a node of the traversal's wide tree.
+  static constexpr int width = 8;
+  // The nodes of the traversal's wide tree (32 bytes per child).
   std::size_t wide_node_count() const { return wide_.size(); }
 
   // For a caller that has stored its primitives in order() (leaf by leaf,
@@ -156,23 +158,26 @@ class bvh {
   }
 
  private:
-  // A node of the traversal's 4-wide tree: its children's boxes (lo x, y, z,
-  // then hi x, y, z, each for the four children; an unused child's box is
+  // A node of the traversal's wide tree: its children's boxes (lo x, y, z,
+  // then hi x, y, z, each for the eight children; an unused child's box is
   // empty, lo = +inf and hi = -inf, which no ray enters), and for each child
   // a wide node's index (count 0) or a leaf's first primitive in order() and
   // its primitive count.
   struct alignas(64) wide_node {
-    std::array<std::array<float, 4>, 6> b;
-    std::array<std::uint32_t, 4> child;
-    std::array<std::uint8_t, 4> count;
+    std::array<std::array<float, width>, 6> b;
+    std::array<std::uint32_t, width> child;
+    std::array<std::uint8_t, width> count;
   };
-  static_assert(sizeof(wide_node) == 128);
+  static_assert(sizeof(wide_node) == 32 * width);
 
   std::vector<node> nodes_;
   std::vector<wide_node, large_array_allocator<wide_node>> wide_;
   std::vector<std::uint32_t> order_;
   bool in_order_ = false;  // order_ is the identity (renumber_in_order)
   std::vector<char> leaf_;  // while collapsing: which binary nodes become leaves
+  // The most entries the traversal's stack can hold on this tree: on a path
+  // from the root, each node's children but one (collapse_node's bound).
+  std::uint32_t stack_bound_ = 0;
 
   static constexpr int bucket_count = 12;
   // The traversal's stack holds at most one node per level. Below this depth
@@ -181,8 +186,11 @@ class bvh {
   static constexpr int balanced_below_depth = 96;
   static constexpr int stack_size = 128;
   // The wide tree is no deeper than the binary one, and a wide node pushes
-  // at most three children beyond the one the traversal goes on with.
-  static constexpr int wide_stack_size = 3 * stack_size + 4;
+  // at most width - 1 children beyond the one the traversal goes on with.
+  static constexpr int wide_stack_size = (width - 1) * stack_size + width;
+  // The stack of a tree whose bound is within it (every tree but lopsided
+  // ones): a smaller frame for each ray.
+  static constexpr int small_stack_size = 96;
 
   // Builds the subtree of order_[begin, end) and returns its node's index.
   std::uint32_t build(const std::vector<aabb>& bounds, const std::vector<vec3>& centroids, std::uint32_t begin,
@@ -265,9 +273,9 @@ class bvh {
     return index;
   }
 
-  // The 4-wide tree of the binary one: from the root, each wide node takes
-  // the binary subtree's nodes down to four children (opening, while fewer
-  // than four, the interior child of the largest surface area). A child
+  // The wide tree of the binary one: from the root, each wide node takes
+  // the binary subtree's nodes down to eight children (opening, while fewer
+  // than eight, the interior child of the largest surface area). A child
   // becomes a leaf where it is a binary leaf, or a subtree of at most
   // max_leaf_size primitives whose boxes would spare a ray entering it few
   // tests: their surface areas add up to at least merge_overlap times the
@@ -303,7 +311,9 @@ class bvh {
                                   area[k] >= merge_overlap * float(count[k]) * aabb{nd.lo, nd.hi}.surface_area());
     }
     wide_.reserve(nodes_.size() / 3 + 1);
-    collapse_node(0, count);
+    std::uint32_t bound = 0;
+    collapse_node(0, count, bound);
+    stack_bound_ = bound + 1;
     leaf_ = {};
   }
 
@@ -313,14 +323,16 @@ class bvh {
     return nodes_[k].offset;
   }
 
-  std::uint32_t collapse_node(std::uint32_t k, const std::vector<std::uint32_t>& count) {
-    std::array<std::uint32_t, 4> slot{k};
+  // Returns the wide node's index; bound: the most stack entries its
+  // subtree's traversal adds beyond the one it started from.
+  std::uint32_t collapse_node(std::uint32_t k, const std::vector<std::uint32_t>& count, std::uint32_t& bound) {
+    std::array<std::uint32_t, width> slot{k};
     int n = 1;
     if (!leaf_[k]) {
       slot = {k + 1, nodes_[k].offset};
       n = 2;
     }
-    while (n < 4) {
+    while (n < width) {
       int open = -1;
       float open_area = -1.0f;
       for (int i = 0; i < n; ++i) {
@@ -336,7 +348,8 @@ class bvh {
     }
     const auto index = static_cast<std::uint32_t>(wide_.size());
     wide_.emplace_back();
-    for (int i = 0; i < 4; ++i) {
+    std::uint32_t below = 0;
+    for (int i = 0; i < width; ++i) {
       const auto u = static_cast<std::size_t>(i);
       std::uint32_t child = 0;
       std::uint8_t leaf_count = 0;
@@ -349,7 +362,9 @@ class bvh {
           child = first_primitive(slot[u]);
           leaf_count = static_cast<std::uint8_t>(count[slot[u]]);
         } else {
-          child = collapse_node(slot[u], count);
+          std::uint32_t b = 0;
+          child = collapse_node(slot[u], count, b);
+          below = std::max(below, b);
         }
       }
       wide_node& w = wide_[index];
@@ -360,45 +375,52 @@ class bvh {
       w.child[u] = child;
       w.count[u] = leaf_count;
     }
+    bound = static_cast<std::uint32_t>(n - 1) + below;
     return index;
   }
 
-  // The slab test of a ray against a node's four boxes, with the far
+  // The slab test of a ray against a node's eight boxes, with the far
   // distance widened by 2 gamma(3) so that rounding cannot reject a box the
   // ray grazes (PBRT 4th ed., sec. 6.8.2): bit i of the result for child i,
   // t0[i] where the ray enters its box. A NaN distance (0 * inf, a ray in a
   // slab's plane) leaves the interval as it is.
   static unsigned hits_boxes(const wide_node& w, const vec3& o, const vec3& inv_d,
                              const std::array<std::size_t, 3>& near_row, const std::array<std::size_t, 3>& far_row,
-                             float tmin, float tmax, std::array<float, 4>& t0) {
+                             float tmin, float tmax, std::array<float, width>& t0) {
     constexpr float widen = 1.0f + 2.0f * rounding_gamma(3);
 #if defined(__GNUC__) || defined(__clang__)
-    // Four lanes at once (GCC's and Clang's vector extensions: SSE, NEON).
-    using float4 = float __attribute__((vector_size(16)));
-    using int4 = std::int32_t __attribute__((vector_size(16)));
-    float4 lo = {tmin, tmin, tmin, tmin}, hi = {tmax, tmax, tmax, tmax};
+    // Every lane at once (GCC's and Clang's vector extensions: AVX, or
+    // pairs of SSE or NEON vectors).
+    using floatw = float __attribute__((vector_size(4 * width)));
+    using intw = std::int32_t __attribute__((vector_size(4 * width)));
+    floatw lo = floatw{} + tmin, hi = floatw{} + tmax;
     for (std::size_t a = 0; a < 3; ++a) {
-      float4 near_plane, far_plane;
-      std::memcpy(&near_plane, w.b[near_row[a]].data(), sizeof(float4));
-      std::memcpy(&far_plane, w.b[far_row[a]].data(), sizeof(float4));
+      floatw near_plane, far_plane;
+      std::memcpy(&near_plane, w.b[near_row[a]].data(), sizeof(floatw));
+      std::memcpy(&far_plane, w.b[far_row[a]].data(), sizeof(floatw));
       const float oa = o[static_cast<int>(a)], ia = inv_d[static_cast<int>(a)];
-      const float4 near = (near_plane - oa) * ia;
-      const float4 far = (far_plane - oa) * ia * widen;
-      const int4 n = near > lo, f = far < hi;
-      lo = reinterpret_cast<float4>((reinterpret_cast<int4>(near) & n) | (reinterpret_cast<int4>(lo) & ~n));
-      hi = reinterpret_cast<float4>((reinterpret_cast<int4>(far) & f) | (reinterpret_cast<int4>(hi) & ~f));
+      const floatw near = (near_plane - oa) * ia;
+      const floatw far = (far_plane - oa) * ia * widen;
+      const intw n = near > lo, f = far < hi;
+      lo = reinterpret_cast<floatw>((reinterpret_cast<intw>(near) & n) | (reinterpret_cast<intw>(lo) & ~n));
+      hi = reinterpret_cast<floatw>((reinterpret_cast<intw>(far) & f) | (reinterpret_cast<intw>(hi) & ~f));
     }
-    const int4 in = lo <= hi;
-    std::memcpy(t0.data(), &lo, sizeof(float4));
-    return unsigned(in[0] & 1) | unsigned(in[1] & 2) | unsigned(in[2] & 4) | unsigned(in[3] & 8);
+    const intw in = lo <= hi;
+    std::memcpy(t0.data(), &lo, sizeof(floatw));
+#if defined(__AVX__)
+    if constexpr (width == 8) return static_cast<unsigned>(__builtin_ia32_movmskps256(reinterpret_cast<floatw>(in)));
+#endif
+    unsigned mask = 0;
+    for (int i = 0; i < width; ++i) mask |= unsigned(in[i] & 1) << i;
+    return mask;
 #else
-    std::array<float, 4> t1;
+    std::array<float, width> t1;
     t0.fill(tmin);
     t1.fill(tmax);
     for (std::size_t a = 0; a < 3; ++a) {
-      const std::array<float, 4>&near_plane = w.b[near_row[a]], &far_plane = w.b[far_row[a]];
+      const std::array<float, width>&near_plane = w.b[near_row[a]], &far_plane = w.b[far_row[a]];
       const float oa = o[static_cast<int>(a)], ia = inv_d[static_cast<int>(a)];
-      for (std::size_t i = 0; i < 4; ++i) {
+      for (std::size_t i = 0; i < width; ++i) {
         const float near = (near_plane[i] - oa) * ia;
         const float far = (far_plane[i] - oa) * ia * widen;
         t0[i] = near > t0[i] ? near : t0[i];
@@ -406,29 +428,32 @@ class bvh {
       }
     }
     unsigned mask = 0;
-    for (std::size_t i = 0; i < 4; ++i) mask |= unsigned(t0[i] <= t1[i]) << i;
+    for (std::size_t i = 0; i < width; ++i) mask |= unsigned(t0[i] <= t1[i]) << i;
     return mask;
 #endif
   }
 
-  // Asks for both cache lines of a wide node ahead of its visit.
+  // Asks for every cache line of a wide node ahead of its visit.
   static void prefetch(const wide_node* w) {
 #if defined(__GNUC__) || defined(__clang__)
-    __builtin_prefetch(w);
-    __builtin_prefetch(reinterpret_cast<const char*>(w) + 64);
+    for (std::size_t b = 0; b < sizeof(wide_node); b += 64) __builtin_prefetch(reinterpret_cast<const char*>(w) + b);
 #else
     (void)w;
 #endif
   }
 
   // Visits the leaves' primitives front to back; visit(prim, tmax) may
-  // lower tmax and returns true to stop. Each box is the slab test, with the
-  // far distance widened by 2 gamma(3) so that rounding cannot reject a box
-  // the ray grazes (PBRT 4th ed., sec. 6.8.2), for a node's four children
-  // at once.
+  // lower tmax and returns true to stop.
   template <class Visit>
   bool traverse(const ray& r, float tmin, float& tmax, Visit&& visit) const {
     if (wide_.empty()) return false;
+    if (stack_bound_ <= static_cast<std::uint32_t>(small_stack_size))
+      return traverse_with<small_stack_size>(r, tmin, tmax, visit);
+    return traverse_with<wide_stack_size>(r, tmin, tmax, visit);
+  }
+
+  template <int StackSize, class Visit>
+  bool traverse_with(const ray& r, float tmin, float& tmax, Visit& visit) const {
     const vec3 inv_d = 1.0f / r.d;
     // The rows of a node's boxes that hold each axis's near and far planes.
     std::array<std::size_t, 3> near_row, far_row;
@@ -442,7 +467,7 @@ class bvh {
       std::uint32_t count;  // leaf: its primitives; 0: a wide node
       float t;              // where the ray enters its box
     };
-    std::array<entry, wide_stack_size> stack;
+    std::array<entry, StackSize> stack;
     int top = 0;
     entry e{0, 0, tmin};
     while (true) {
@@ -451,7 +476,7 @@ class bvh {
           if (visit(in_order_ ? e.child + i : order_[e.child + i], tmax)) return true;
       } else {
         const wide_node& w = wide_[e.child];
-        std::array<float, 4> t0;
+        std::array<float, width> t0;
         unsigned mask = hits_boxes(w, r.o, inv_d, near_row, far_row, tmin, tmax, t0);
         if (mask != 0) {
           const auto child = [&](unsigned i) { return entry{w.child[i], w.count[i], t0[i]}; };
