@@ -49,6 +49,8 @@ class Mitsuba:
         before = _thread_cpu() if busy is not None else None
         c0, t0 = time.process_time(), time.perf_counter()
         img = self.mi.render(scene, spp=spp, seed=seed)
+        self.dr.eval(img)  # LLVM variants evaluate lazily: the rendering happens here
+        self.dr.sync_thread()
         t1, c1 = time.perf_counter(), time.process_time()
         if busy is not None:
             after = _thread_cpu()
