@@ -16,8 +16,9 @@
 // it comes back to them, those it enters beyond its closest hit so far;
 // shadow rays stop at the first hit. On incoherent rays through a large
 // mesh the traversal waits on memory, for nodes and primitives alike: the
-// wide tree is a third as deep as the binary one, and its nodes live in
-// huge pages where the system offers them (large_array_allocator).
+// wide tree is a third as deep as the binary one (9 levels against 27 on
+// 1.29 million triangles), and its nodes live in huge pages where the
+// system offers them (large_array_allocator).
 //
 // The hierarchy knows its primitives only through their bounds, at build
 // time, and through a callback at traversal: it holds their order, so a
