@@ -472,37 +472,6 @@ loaded_scene load_scene(const std::string& path, std::optional<light_sampling> o
     read_object(rd, objs[i], "objects[" + std::to_string(i) + "]", out.world, ids, override_strategy, map, ap, auto_pilot,
                 auto_receivers, out);
 
-  // Self-intersection guard proportional to the scene's coordinates: a few
-  // thousand float ulps of the largest coordinate any shape reaches (1.1e-3
-  // for the 555-unit Cornell box, Shirley's 0.001). Each shape counts with
-  // all of its extent: every corner of a rectangle or a box, the bounding
-  // box of an ellipse (its reach along axis i is sqrt(a1_i^2 + a2_i^2)) and
-  // of a sphere.
-  float extent = 1.0f;
-  auto grow = [&](vec3 p) { extent = std::max({extent, std::abs(p.x), std::abs(p.y), std::abs(p.z)}); };
-  auto grow_about = [&](vec3 c, vec3 reach) { grow(glm::abs(c) + reach); };
-  for (std::size_t i = 0; i < out.world.axis_rects.size(); ++i) {
-    const any_axis_rect& a = out.world.axis_rects[i];
-    vec3 lo, hi;
-    lo[a.axis] = hi[a.axis] = a.k;
-    lo[(a.axis + 1) % 3] = a.a0, hi[(a.axis + 1) % 3] = a.a1;
-    lo[(a.axis + 2) % 3] = a.b0, hi[(a.axis + 2) % 3] = a.b1;
-    grow(lo), grow(hi);
-  }
-  for (const auto& o : std::get<std::vector<object<rect>>>(out.world.objects)) {
-    const rect& r = o.shape;
-    grow(r.corner), grow(r.corner + r.e1), grow(r.corner + r.e2), grow(r.corner + r.e1 + r.e2);
-  }
-  for (const auto& o : std::get<std::vector<object<ellipse>>>(out.world.objects))
-    grow_about(o.shape.center, glm::sqrt(o.shape.a1 * o.shape.a1 + o.shape.a2 * o.shape.a2));
-  for (const auto& o : std::get<std::vector<object<sphere>>>(out.world.objects))
-    grow_about(o.shape.center, vec3(o.shape.radius));
-  for (const auto& o : std::get<std::vector<object<box>>>(out.world.objects))
-    for (int c = 0; c < 8; ++c) {
-      const box& b = o.shape;
-      grow(b.xf.to_world({(c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z}));
-    }
-  out.world.ray_epsilon = 2e-6f * extent;
   // Shirley's scenes keep their lists: their few shapes are large (the
   // Cornell boxes' boxes), which the hierarchy's boxes do not cull, and
   // they render 11-22 % slower through it (bench/ab_render.sh).

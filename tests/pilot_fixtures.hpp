@@ -20,7 +20,6 @@ inline scene lit_floor(bool projected = false) {
     sc.add_light(rect_projected_solid_angle_sampler{r}, 1);
   else
     sc.add_light(rect_area_sampler{r}, 1);
-  sc.ray_epsilon = 1e-4f;
   return sc;
 }
 

@@ -61,7 +61,6 @@ TEST(ChoiceGainPilot, FootprintHoldsEveryPixelThatSeesAnEmitter) {
   sc.add(xz_rect_shape{-50, 50, -50, 50, 0}, 0);
   sc.add_light(rect_area_sampler{xy_rect(-0.3f, 0.1f, 0.3f, 0.7f, 0.5f, true)}, 1);
   sc.add_light(sphere_area_sampler{sphere{{0.5f, 0.4f, 0.2f}, 0.15f}}, 1);
-  sc.ray_epsilon = 1e-4f;
   const camera cam({0, 0.8f, -2}, {0, 0.4f, 0}, {0, 1, 0}, 40, 1.0f);
   const int w = 64, h = 64;
   const std::vector<std::uint8_t> mask = emitter_footprint(sc, cam, w, h);
@@ -173,7 +172,7 @@ TEST(ChoiceGainPilot, LightVarianceUnbiased) {
       for (int k = 0; k < 16; ++k) {
         double v = 0.0;
         hit_record rec;
-        if (sc.hit(pixel_ray(cam, x, y, rng.uniform2(), 1.0f / w, 1.0f / h), sc.ray_epsilon, infinity, rec)) {
+        if (sc.hit(pixel_ray(cam, x, y, rng.uniform2(), 1.0f / w, 1.0f / h), 0.0f, infinity, rec)) {
           const vec3 nf = rec.facing_normal();
           std::vector<glm::dvec3> f;
           for (int j = 0; j < 64; ++j) {
@@ -260,7 +259,6 @@ struct settle_floor {
     pilot_scene.materials = {lambertian{color(0.5f)}, diffuse_light{color(4.0f)}};
     pilot_scene.add(xz_rect_shape{-50, 50, -50, 50, 0}, 0);
     pilot_scene.add_light(rect_area_sampler{r}, 1);
-    pilot_scene.ray_epsilon = 1e-4f;
   }
   // The light's `auto` params with the pilot's V.
   static auto_params params(const noise_pilot_result& noise) {

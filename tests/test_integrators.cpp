@@ -244,7 +244,6 @@ TEST(Integrators, AgreeOnOverlappingAndUnlistedLights) {
   sc.add_light(ellipse_area_sampler{ellipse::make({0.2f, 1.5f, 0}, {0.3f, 0, 0}, {0, 0, 0.3f})}, 2);  // small, in front
   sc.add_light(rect_area_sampler{xz_rect(1.5f, 2.5f, -1, 1, 2.5f, false)}, 1);    // faces up: never seen from below
   sc.add(sphere{{-1.5f, 0.5f, 0.5f}, 0.4f}, 3);                                    // emits, not listed
-  sc.ray_epsilon = 1e-4f;
   const camera cam({0, 1.2f, -4}, {0, 0.6f, 0}, {0, 1, 0}, 60, 1.0f);
   render_settings rs;
   rs.width = rs.height = 20;
@@ -297,11 +296,8 @@ TEST(Integrators, AgreeInMeanWithCosineAwareStrategies) {
 
 // The scene loader keeps a `rect` turned in a coordinate plane as a general
 // rectangle (only one whose edges lie along the axes joins the axis-aligned
-// set), and its self-intersection guard is 2e-6 of the largest coordinate any
-// shape reaches: here the turned rectangle's corner + edge1 (x = 900), which
-// neither its corner nor corner + edge1 + edge2 reaches, beyond a sphere whose
-// reach (z = 700) lies beyond its centre.
-TEST(SceneLoader, TurnedRectanglesStayGeneralAndTheGuardCountsEveryCorner) {
+// set).
+TEST(SceneLoader, TurnedRectanglesStayGeneral) {
   const std::filesystem::path file =
       std::filesystem::temp_directory_path() / ("mcrt_loader_" + std::to_string(::getpid()) + ".json");
   std::ofstream(file) << R"({
@@ -316,7 +312,6 @@ TEST(SceneLoader, TurnedRectanglesStayGeneralAndTheGuardCountsEveryCorner) {
   std::filesystem::remove(file);
   EXPECT_EQ(ls.world.axis_rects.size(), 1u) << "only the rectangle with edges along the axes is axis-aligned";
   EXPECT_EQ(std::get<std::vector<object<rect>>>(ls.world.objects).size(), 1u);
-  EXPECT_FLOAT_EQ(ls.world.ray_epsilon, 2e-6f * 900.0f);
 }
 
 // `auto` (a strategy chosen per light and shading point) on a rectangle, a
@@ -342,7 +337,6 @@ double floor_rmse(sampler_kind sk, light_sampling strategy, int n) {
   scene sc;
   sc.materials = {lambertian{color(albedo)}, diffuse_light{color(emit)}};
   sc.add(xz_rect_shape{-50, 50, -50, 50, 0}, 0);
-  sc.ray_epsilon = 1e-4f;
   const rect lr = xz_rect(-0.3f, 0.3f, -0.2f, 0.2f, h, true);
   if (strategy == light_sampling::area)
     sc.add_light(rect_area_sampler{lr}, 1);

@@ -43,7 +43,6 @@ TEST(NoisePilot, ZeroWithoutNoiseAndLessWithABetterStrategy) {
   scene flat;
   flat.materials = {diffuse_light{color(2.0f)}};
   flat.add(xy_rect_shape{-100, 100, -100, 100, 5, true}, 0);  // front side towards the camera
-  flat.ray_epsilon = 1e-4f;
   const camera front({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 30, 1.0f);
   render_settings rs = settings(40, 40);
   rs.spp = 2;
@@ -105,7 +104,6 @@ TEST(NoisePilot, EmittersInViewUnbiasedAndSteadier) {
   // A light over the floor, its front towards the camera.
   const rect r = xy_rect(-0.3f, 0.3f, 0.3f, 0.7f, 0.5f, true);
   sc.add_light(rect_area_sampler{r}, 1);
-  sc.ray_epsilon = 1e-4f;
   const camera cam({0, 0.6f, -2}, {0, 0.4f, 0}, {0, 1, 0}, 40, 1.0f);
   render_settings rs = settings(32, 32);
   rs.seed = 3;
@@ -158,7 +156,6 @@ TEST(NoisePilot, EmittersInViewAtAnyPilotSize) {
     sc.materials = {lambertian{color(0.3f)}, diffuse_light{color(20.0f)}};
     sc.add(xz_rect_shape{-50, 50, -50, 50, 0}, 0);
     sc.add_light(rect_area_sampler{xy_rect(-0.3f, 0.3f, 0.3f, 0.7f, 0.5f, true)}, 1);
-    sc.ray_epsilon = 1e-4f;
     const camera cam(from, {0, 0.4f, 0}, {0, 1, 0}, 40, 1.0f);
     render_settings rs = settings(96, 96);
     rs.seed = 5;
@@ -224,7 +221,6 @@ void check_edge_noise_factor(sampler_kind kind) {
   sc.materials = {lambertian{color(0.3f)}, diffuse_light{color(20.0f)}};
   sc.add(xz_rect_shape{-50, 50, -50, 50, 0}, 0);
   sc.add_light(sphere_area_sampler{sphere{{0.0f, 0.5f, 0.0f}, 0.25f}}, 1);
-  sc.ray_epsilon = 1e-4f;
   const camera cam({0, 0.8f, -2}, {0, 0.4f, 0}, {0, 1, 0}, 40, 1.0f);
   render_settings rs = settings(48, 48);
   rs.spp = 8;

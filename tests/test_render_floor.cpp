@@ -51,7 +51,6 @@ scene floor_scene() {
   scene sc;
   sc.materials = {lambertian{color(albedo)}, diffuse_light{color(emit)}};
   sc.add(xz_rect_shape{-50, 50, -50, 50, 0}, 0);
-  sc.ray_epsilon = 1e-4f;
   return sc;
 }
 

@@ -21,11 +21,6 @@ std::string quoted(const std::string& s) { return "\"" + s + "\""; }
 constexpr int max_samples_per_pixel = 1 << 20;
 constexpr int max_path_depth = 100000;
 
-std::string join_names(const std::vector<std::string>& names) {
-  std::string out;
-  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
-  return out;
-}
 
 [[noreturn]] void refuse(const file_loc& loc, const std::string& what) { throw parse_error(loc, what); }
 
@@ -165,7 +160,6 @@ class builder {
     if (!saw_world_) refuse(ds.empty() ? file_loc{} : ds.back().loc, "the file has no WorldBegin");
     if (!stack_.empty()) refuse(ds.back().loc, "AttributeBegin without AttributeEnd");
     if (out_.world.object_count() == 0) refuse(ds.back().loc, "the scene has no shapes");
-    out_.world.ray_epsilon = 2e-6f * extent_;
     out_.world.build_accelerator();
     return std::move(out_);
   }
@@ -180,7 +174,6 @@ class builder {
   std::map<std::string, std::uint32_t> named_materials_;
   std::map<std::string, texture_entry> spectrum_textures_, float_textures_;
   bool saw_world_ = false, saw_camera_ = false;
-  float extent_ = 1.0f;
 
   std::string resolve(const std::string& name) const {
     const fs::path p(name);
@@ -644,11 +637,6 @@ class builder {
 
   // ---- shapes ----------------------------------------------------------------
 
-  void grow_extent(const aabb& b) {
-    extent_ = std::max({extent_, std::abs(b.lo.x), std::abs(b.lo.y), std::abs(b.lo.z), std::abs(b.hi.x), std::abs(b.hi.y),
-                        std::abs(b.hi.z)});
-  }
-
   // The material a shape gets: its own, or for an emitter a diffuse_light
   // that reflects with it.
   std::uint32_t shape_material(bool& emits) {
@@ -763,7 +751,6 @@ class builder {
     if (emits) strategy_for("triangle", p.loc(), light_sampling::area);
     for (const triangle& tri : triangles_of(mesh)) {
       if (tri.area() == 0.0f) continue;  // a degenerate triangle is never hit
-      grow_extent(tri.bounds());
       out_.world.add(tri, mat);
       if (emits) {
         const triangle_area_sampler front(tri);
@@ -888,7 +875,6 @@ class builder {
     // pbrt-v4's intersection: the outward normal, flipped by
     // ReverseOrientation and by a transform that swaps handedness.
     sp.flip = state_.reverse_orientation != state_.ctm.swaps_handedness();
-    grow_extent(sp.bounds());
     bool emits = false;
     const std::uint32_t mat = shape_material(emits);
     if (!emits) {
@@ -934,7 +920,6 @@ class builder {
     if (state_.reverse_orientation != x.swaps_handedness()) n = -n;
     const bool flip = glm::dot(glm::cross(a1, a2), n) < 0.0;
     const ellipse e = ellipse::make(vec3(c), vec3(a1), vec3(a2), flip);
-    grow_extent(e.bounds());
     bool emits = false;
     const std::uint32_t mat = shape_material(emits);
     out_.world.add(e, mat);

@@ -5,6 +5,8 @@
 #include <glm/glm.hpp>
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -42,6 +44,25 @@ inline T safe_acos(T x) { return std::acos(std::clamp(x, T(-1), T(1))); }
 constexpr float rounding_gamma(int n) {
   constexpr float u = 0x1p-24f;
   return (static_cast<float>(n) * u) / (1.0f - static_cast<float>(n) * u);
+}
+
+// The next float above / below v (pbrt-v4's NextFloatUp / NextFloatDown):
+// a ray origin moved off a surface is rounded away from it, so that the
+// rounding of the move cannot bring it back inside the error bound. Both
+// zeros step to the smallest denormal; infinities stay.
+inline float next_float_up(float v) {
+  if (std::isinf(v) && v > 0.0f) return v;
+  if (v == -0.0f) v = 0.0f;
+  std::uint32_t ui = std::bit_cast<std::uint32_t>(v);
+  ui = v >= 0.0f ? ui + 1 : ui - 1;
+  return std::bit_cast<float>(ui);
+}
+inline float next_float_down(float v) {
+  if (std::isinf(v) && v < 0.0f) return v;
+  if (v == 0.0f) v = -0.0f;
+  std::uint32_t ui = std::bit_cast<std::uint32_t>(v);
+  ui = v > 0.0f ? ui - 1 : ui + 1;
+  return std::bit_cast<float>(ui);
 }
 
 inline bool all_finite(const vec3& v) {

@@ -46,7 +46,10 @@ struct axis_rect {
   void surface(const ray& r, float t, hit_record& rec) const {
     rec.t = t;
     rec.p = r.at(t);
-    rec.p[Axis] = k;  // exactly on the plane
+    // Exactly on the plane, so no error bound: a ray leaving it has t = 0
+    // for this plane, which the test's t > tmin = 0 rejects.
+    rec.p[Axis] = k;
+    rec.offset = 0.0f;
     rec.n = normal();
     rec.front_face = (r.d[Axis] < 0.0f) != flip;
   }

@@ -25,7 +25,10 @@ struct any_axis_rect {
   void surface(const ray& r, float t, hit_record& rec) const {
     rec.t = t;
     rec.p = r.at(t);
-    rec.p[axis] = k;  // exactly on the plane
+    // Exactly on the plane, so no error bound: a ray leaving it has t = 0
+    // for this plane, which the test's t > tmin = 0 rejects.
+    rec.p[axis] = k;
+    rec.offset = 0.0f;
     rec.n = vec3(0.0f);
     rec.n[axis] = flip ? -1.0f : 1.0f;
     rec.front_face = (r.d[axis] < 0.0f) != flip;

@@ -42,10 +42,10 @@ struct box {
   // The hit record of a hit at t found by intersect(): the face is the one
   // whose plane the local hit point is nearest to, relative to the box size.
   // The hit point is that local point moved onto the face's plane exactly,
-  // then to the world, with the bound of that transform's rounding as the
+  // then to the world, with the bound of that transform's rounding in the
   // record's offset: the ray's own point o + t d may lie inside the box by
   // its rounding (1e-5 of a 500-unit scene), and a ray leaving a face at a
-  // grazing angle from there would meet the box again past t_min.
+  // grazing angle from there would meet the box again.
   void surface(const ray& world_ray, float t, hit_record& rec) const {
     vec3 p = xf.to_local(world_ray.at(t));
     const vec3 size = hi - lo;
@@ -62,7 +62,12 @@ struct box {
     rec.t = t;
     rec.p = xf.to_world(p);
     const vec3 outward = xf.rotate(local_n);
-    rec.offset = glm::dot(glm::abs(outward), xf.to_world_error(p));
+    // Twice the bound of the world point's rounding: once for where the
+    // point truly lies, once for the rounding of the move back to the box's
+    // frame that a leaving ray's slab test makes (the inverse rigid motion,
+    // the same magnitudes), so that its origin lands outside the face (or
+    // inside, for a ray going in) in the box's frame too.
+    rec.offset = 2.0f * glm::dot(glm::abs(outward), xf.to_world_error(p));
     rec.n = flip ? -outward : outward;
     rec.front_face = glm::dot(world_ray.d, rec.n) < 0.0f;
   }

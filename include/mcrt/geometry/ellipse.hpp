@@ -4,6 +4,7 @@
 #include "mcrt/core/ray.hpp"
 #include "mcrt/geometry/aabb.hpp"
 #include "mcrt/geometry/hit_record.hpp"
+#include "mcrt/geometry/surface_point.hpp"
 
 namespace mcrt {
 
@@ -49,10 +50,13 @@ struct ellipse {
     return sqr(glm::dot(q, a1_dual)) + sqr(glm::dot(q, a2_dual)) <= 1.0f;
   }
 
-  // The hit record of a hit at t found by intersect().
+  // The hit record of a hit at t found by intersect(): the ray's point
+  // moved onto the plane, with its error bound (surface_point.hpp).
   void surface(const ray& r, float t, hit_record& rec) const {
     rec.t = t;
-    rec.p = r.at(t);
+    const plane_point q = onto_plane(r.at(t), n, plane);
+    rec.p = q.p;
+    rec.offset = q.offset;
     rec.n = n;
     rec.front_face = glm::dot(r.d, n) < 0.0f;
   }

@@ -14,11 +14,12 @@ struct hit_record {
   std::uint32_t material = 0;
   bool front_face = true;  // the ray arrives at the front side: dot(d, n) < 0
   // A bound on how far the computed p may lie from the true surface along
-  // n (the rounding of its computation, dot(|n|, error bound of p)), or 0
-  // where the shape gives none: a ray leaving the surface starts this far off
-  // it on the side it leaves to (spawn_origin), so that it cannot meet the
-  // surface it leaves (Pharr et al., "Physically Based Rendering", 4th ed.,
-  // sec. 6.8.6). Rays also start past the scene's t_min (scene::ray_epsilon).
+  // n (the rounding of its computation, dot(|n|, error bound of p)); 0 where
+  // p lies exactly on it (the coordinate planes of axis-aligned rectangles).
+  // A ray leaving the surface starts this far off it on the side it leaves
+  // to (spawn_origin), and rays are then intersected from t = 0: a shape's
+  // own test cannot meet the surface it leaves (Pharr et al., "Physically
+  // Based Rendering", 4th ed., sec. 6.8.6). Every shape sets it.
   float offset = 0.0f;
   // Where the shape has them (triangles of meshes): the unit shading normal
   // (interpolated vertex normals, on the side of n), the texture coordinates
@@ -40,8 +41,19 @@ struct hit_record {
   }
 
   // The origin of a ray leaving p along dir: p moved off the surface by
-  // `offset` to the side dir points into (pbrt-v4's OffsetRayOrigin).
-  vec3 spawn_origin(const vec3& dir) const { return p + (glm::dot(dir, n) < 0.0f ? -offset : offset) * n; }
+  // `offset` to the side dir points into, each coordinate then rounded
+  // away from the surface, so that the move's own rounding cannot undo it
+  // (pbrt-v4's OffsetRayOrigin). p itself where the offset is 0.
+  vec3 spawn_origin(const vec3& dir) const {
+    if (offset == 0.0f) return p;
+    const vec3 off = (glm::dot(dir, n) < 0.0f ? -offset : offset) * n;
+    vec3 o = p + off;
+    for (int i = 0; i < 3; ++i) {
+      if (off[i] > 0.0f) o[i] = next_float_up(o[i]);
+      else if (off[i] < 0.0f) o[i] = next_float_down(o[i]);
+    }
+    return o;
+  }
 };
 
 }  // namespace mcrt

@@ -6,6 +6,7 @@
 #include "mcrt/core/ray.hpp"
 #include "mcrt/geometry/aabb.hpp"
 #include "mcrt/geometry/hit_record.hpp"
+#include "mcrt/geometry/surface_point.hpp"
 
 namespace mcrt {
 
@@ -57,10 +58,13 @@ struct rect {
     return a >= 0.0f && a <= 1.0f && b >= 0.0f && b <= 1.0f;
   }
 
-  // The hit record of a hit at t found by intersect().
+  // The hit record of a hit at t found by intersect(): the ray's point
+  // moved onto the plane, with its error bound (surface_point.hpp).
   void surface(const ray& r, float t, hit_record& rec) const {
     rec.t = t;
-    rec.p = r.at(t);
+    const plane_point q = onto_plane(r.at(t), n, plane);
+    rec.p = q.p;
+    rec.offset = q.offset;
     rec.n = n;
     rec.front_face = glm::dot(r.d, n) < 0.0f;
   }

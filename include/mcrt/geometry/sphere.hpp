@@ -3,6 +3,7 @@
 #include "mcrt/core/ray.hpp"
 #include "mcrt/geometry/aabb.hpp"
 #include "mcrt/geometry/hit_record.hpp"
+#include "mcrt/geometry/surface_point.hpp"
 
 namespace mcrt {
 
@@ -41,10 +42,13 @@ struct sphere {
     return false;
   }
 
-  // The hit record of a hit at t found by intersect().
+  // The hit record of a hit at t found by intersect(): the ray's point
+  // moved onto the sphere, with its error bound (surface_point.hpp).
   void surface(const ray& r, float t, hit_record& rec) const {
     rec.t = t;
-    rec.p = r.at(t);
+    const sphere_point q = onto_sphere(r.at(t), center, radius);
+    rec.p = q.p;
+    rec.offset = q.offset;
     const vec3 outward = (rec.p - center) / radius;
     rec.n = flip ? -outward : outward;
     rec.front_face = glm::dot(r.d, rec.n) < 0.0f;

@@ -48,14 +48,16 @@ struct transformed {
     return shape.intersect(xf.to_local(r), tmin, tmax, t);
   }
 
-  // The hit record of a hit at t, moved back to the world. The world point
-  // is the ray's at t, with no error bound (offset 0: rays leaving it rely
-  // on the scene's t_min).
+  // The hit record of a hit at t, moved back to the world: the shape's
+  // point in its frame, moved by the rigid motion, with the shape's own
+  // bound plus twice the motion's rounding (once for the world point, once
+  // for the move back a leaving ray's test makes; see box.hpp).
   void surface(const ray& r, float t, hit_record& rec) const {
     shape.surface(xf.to_local(r), t, rec);
-    rec.p = r.at(t);
+    const vec3 local_p = rec.p;
+    rec.p = xf.to_world(local_p);
     rec.n = xf.rotate(rec.n);
-    rec.offset = 0.0f;
+    rec.offset += 2.0f * glm::dot(glm::abs(rec.n), xf.to_world_error(local_p));
   }
 
   bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {

@@ -105,7 +105,7 @@ double choice_gain_factor_with(const Scene& sc, const camera& cam, const render_
   // d at one camera sample: 0 where its ray meets no diffuse surface.
   return sequence_noise_factor<Sampler>(rs, pixels, seed, scramblings, [&](auto& px, int x, int y) {
     hit_record rec;
-    if (!sc.hit(camera_ray(cam, px, x, y, inv_w, inv_h), sc.ray_epsilon, infinity, rec)) return 0.0;
+    if (!sc.hit(camera_ray(cam, px, x, y, inv_w, inv_h), 0.0f, infinity, rec)) return 0.0;
     const auto* lam = std::get_if<lambertian>(&sc.materials[rec.material]);
     if (!lam) return 0.0;
     const vec3 nf = rec.facing_normal();

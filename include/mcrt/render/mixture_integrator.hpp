@@ -24,7 +24,7 @@ struct mixture_integrator {
     color radiance(0.0f), throughput(1.0f);
     for (int depth = 0;; ++depth) {
       hit_record rec;
-      if (!sc.hit(r, sc.ray_epsilon, infinity, rec)) {
+      if (!sc.hit(r, 0.0f, infinity, rec)) {
         radiance += throughput * sc.background;
         break;
       }

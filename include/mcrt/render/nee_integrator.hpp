@@ -100,7 +100,7 @@ struct next_event_integrator {
     float prev_p_material = 0.0f;
     for (int depth = 0;; ++depth) {
       hit_record rec;
-      if (!sc.hit(r, sc.ray_epsilon, infinity, rec)) {
+      if (!sc.hit(r, 0.0f, infinity, rec)) {
         radiance += throughput * sc.background;
         break;
       }

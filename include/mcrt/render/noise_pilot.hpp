@@ -106,7 +106,6 @@ struct ray_counting_scene {
   const decltype(Scene::emitters)& emitters = inner.emitters;
   const decltype(Scene::materials)& materials = inner.materials;
   const color& background = inner.background;
-  const float& ray_epsilon = inner.ray_epsilon;
   const std::size_t& unsampled_emitters = inner.unsampled_emitters;
 
   bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
@@ -161,7 +160,7 @@ struct counting_pixel_sampler {
 template <class Scene>
 color radiance_met_first(const Scene& sc, const ray& r) {
   hit_record rec;
-  if (!sc.hit(r, sc.ray_epsilon, infinity, rec)) return sc.background;
+  if (!sc.hit(r, 0.0f, infinity, rec)) return sc.background;
   return emitted(sc.materials[rec.material], rec);
 }
 
@@ -458,7 +457,7 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
         const int x = b.x, y = b.y;
         // The surface at the pixel's centre: its albedo, if diffuse.
         hit_record rec;
-        if (sc.hit(pixel_ray(cam, x, y, vec2(0.5f), inv_w, inv_h), sc.ray_epsilon, infinity, rec))
+        if (sc.hit(pixel_ray(cam, x, y, vec2(0.5f), inv_w, inv_h), 0.0f, infinity, rec))
           if (const auto* l = std::get_if<lambertian>(&sc.materials[rec.material])) {
             const double a = (double(l->albedo.r) + l->albedo.g + l->albedo.b) / 3.0;
             albedo2 += a * a;
@@ -481,7 +480,7 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
           // divides by it.
           if (nl == 0 || s > 0) continue;  // at the first sample's point of each pixel
           hit_record rec1;
-          if (!sc.hit(r, sc.ray_epsilon, infinity, rec1)) continue;
+          if (!sc.hit(r, 0.0f, infinity, rec1)) continue;
           const auto* lam = std::get_if<lambertian>(&sc.materials[rec1.material]);
           if (!lam) continue;
           const vec3 nf = rec1.facing_normal();

@@ -53,9 +53,6 @@ struct basic_scene {
   // The lights that emit, for the next-event estimators (nee, mis).
   std::vector<emitter> emitters;
   color background{0.0f};
-  // Rays start this far from the surface they leave (self-intersection guard,
-  // Shirley's t_min); set from the scene's size by whoever builds it.
-  float ray_epsilon = 1e-3f;
   // Shapes added by add() (not add_light) whose material emits, or was not
   // yet known when they were added: light that only the material's samples
   // of a next-event estimator can find (see nee_integrator.hpp).
