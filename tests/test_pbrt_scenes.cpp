@@ -139,6 +139,24 @@ TEST_P(PbrtFloor, ReverseOrientationDecidesTheEmittingSide) {
   EXPECT_EQ(floor_radiance(b.world, GetParam(), 0.1f, 0.0f, 50).mean, 0.0);
 }
 
+// With shading normals the triangle faces them, and ReverseOrientation
+// turns them (pbrt-v4 negates a mesh's N under it): N = +z in object space
+// is -y in the world, so without ReverseOrientation the triangle faces the
+// floor and lights it, and with it faces up and gives the floor nothing.
+TEST_P(PbrtFloor, ReverseOrientationTurnsTheShadingNormals) {
+  const std::string normals = "\"normal N\" [ 0 0 1  0 0 1  0 0 1 ] ";
+  std::string reversed = floor_scene(with(nested_triangle, ""));
+  reversed.insert(reversed.find("\"integer indices\" [ 0 1 2 ]"), normals);
+  std::string plain = reversed;
+  plain.erase(plain.find("ReverseOrientation"), std::string("ReverseOrientation").size());
+  const pbrt::built_scene r = from_text(reversed), b = from_text(plain);
+  EXPECT_EQ(floor_radiance(r.world, GetParam(), 0.1f, 0.0f, 51).mean, 0.0) << "reversed: faces up";
+  const std::vector<glm::dvec3> poly = light_triangles(b.world).at(0);
+  int id = 70;
+  for (const auto& [x, z] : floor_points)
+    check(floor_radiance(b.world, GetParam(), x, z, id++), polygon_floor(poly, x, z), "normals facing the floor");
+}
+
 // Two-sided: the up-facing triangle lights the floor with its back, and its
 // power counts both sides.
 TEST_P(PbrtFloor, TwoSidedTriangleLightsFromItsBack) {

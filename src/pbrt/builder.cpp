@@ -735,10 +735,14 @@ class builder {
       v = vec3(x.point(glm::dvec3(v)));
       if (!all_finite(v)) p.fail("has a point that is not finite (after the transformation)");
     }
+    // Shading normals move as normals, and ReverseOrientation turns them
+    // (pbrt-v4's TriangleMesh and BilinearPatchMesh negate N under it; a
+    // mirroring transform does not).
     for (vec3& n : m.n) {
       const glm::dvec3 w = x.normal(glm::dvec3(n));
       const double len = glm::length(w);
       n = len > 0.0 ? vec3(w / len) : vec3(0.0f);
+      if (state_.reverse_orientation) n = -n;
     }
     // pbrt-v4's triangles: the geometric normal is the world-space cross
     // product, reversed by ReverseOrientation and by a transform that swaps

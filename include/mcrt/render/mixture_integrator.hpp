@@ -71,7 +71,9 @@ struct mixture_integrator {
         const shading_frame fr = shading_frame::from_normal_tangent(rec.shading_normal(), rec.dpdu);
         const vec3 wo = fr.to_local(-glm::normalize(r.d));
         const vec3 n = wo.z < 0.0f ? -fr.z : fr.z;
-        const light_pdf<light> lights(sc.lights, rec.p, n);
+        // From the point moved off the surface to the side the ray came from
+        // (as nee_integrator.hpp's light selection).
+        const light_pdf<light> lights(sc.lights, rec.spawn_origin(-r.d), n);
         const float u_select = ps.get1d(b + layout::light_choice);
         vec3 wi_local;
         color f;

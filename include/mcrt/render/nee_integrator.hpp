@@ -152,8 +152,11 @@ struct next_event_integrator {
         scattered = true;
         const shading_frame fr = shading_frame::from_normal_tangent(rec.shading_normal(), rec.dpdu);
         const vec3 wo = fr.to_local(-glm::normalize(r.d));
-        // The light technique's density with the shading normal on wo's side.
-        const light_selection sel(sc, rec.p, wo.z < 0.0f ? -fr.z : fr.z, set.choose);
+        // The light technique's density with the shading normal on wo's
+        // side, from the point moved off the surface to the side the ray
+        // came from: on an emitter's own surface, its plane's side decides
+        // by more than rounding whether its own light faces the point.
+        const light_selection sel(sc, rec.spawn_origin(-r.d), wo.z < 0.0f ? -fr.z : fr.z, set.choose);
         if (!bsdf.is_delta())
           radiance += throughput * sample_direct_light_bsdf<Weights>(sc, rec, fr, wo, bsdf, sel, ps, b, set);
         if (depth >= set.rr_depth && !survive_roulette(throughput, [&] { return ps.get1d(b + layout::roulette); })) {
