@@ -93,9 +93,9 @@ struct basic_scene {
 
   // A scene with at most this many shapes in its lists keeps testing the
   // lists. On random small shapes (bench/bench_samplers_scene_accel.cpp:
-  // closest hits, 1 to 64 spheres and triangles) the hierarchy costs 4.3 ns
-  // against the list's 4.1 ns for one shape, and already halves the time
-  // for two (5.5 against 11.9 ns).
+  // closest hits, 1 to 64 spheres and triangles) the hierarchy is slower
+  // than the list for one shape and faster from two on (the numbers:
+  // bench/results/pbrt/README.md).
   static constexpr std::size_t list_limit = 1;
 
   // Builds the hierarchy over every shape of the lists (not the
