@@ -387,6 +387,42 @@ TEST(Warp, UniformConeRoundTrip) {
   }
 }
 
+// The concentric disk map (the thin lens): inside the unit disk, its own
+// inverse, and pdf 1/pi inside, 0 outside.
+TEST(Warp, ConcentricDiskRoundTrip) {
+  pcg32 rng(26, 1);
+  for (int i = 0; i < 200'000; ++i) {
+    const vec2 u = rng.uniform2();
+    const vec2 p = square_to_uniform_disk_concentric(u);
+    ASSERT_LE(glm::length(p), 1.0f + 1e-6f);
+    ASSERT_FLOAT_EQ(square_to_uniform_disk_concentric_pdf(p * (1.0f - 1e-6f)), inv_pi);
+    const vec2 v = uniform_disk_concentric_to_square(p);
+    ASSERT_NEAR(v.x, u.x, 2e-5) << "u = " << u.x << ", " << u.y;
+    ASSERT_NEAR(v.y, u.y, 2e-5) << "u = " << u.x << ", " << u.y;
+  }
+  EXPECT_EQ(square_to_uniform_disk_concentric(vec2(0.5f)), vec2(0.0f));  // the centre, no 0/0
+  EXPECT_EQ(square_to_uniform_disk_concentric_pdf(vec2(0.8f, 0.61f)), 0.0f);
+  // The square's corners go to the diagonals, its edge midpoints to the axes.
+  EXPECT_LT(glm::length(square_to_uniform_disk_concentric(vec2(1.0f, 1.0f)) - vec2(std::sqrt(0.5f))), 1e-6f);
+  EXPECT_LT(glm::length(square_to_uniform_disk_concentric(vec2(0.5f, 0.0f)) - vec2(0.0f, -1.0f)), 1e-6f);
+}
+
+// Uniform over the disk, tested as directions: a point uniform on the unit
+// disk lifted to the hemisphere (z = sqrt(1 - r^2)) is cosine-distributed
+// (Malley's method), so the lifted samples must pass the chi-square test
+// against cos(theta) / pi.
+TEST(Warp, ConcentricDiskChiSquare) {
+  const chi2_result r = test::chi2_test_directions(
+      [](pcg32& rng, vec3& d) {
+        const vec2 p = square_to_uniform_disk_concentric(rng.uniform2());
+        d = vec3(p, safe_sqrt(1.0f - glm::dot(p, p)));
+        return true;
+      },
+      [](const vec3& d) { return square_to_cosine_hemisphere_pdf(d); }, dvec3(0, 0, 1), 1.0,
+      {.sample_count = chi2_samples, .seed = 404});
+  expect_chi2_passed(r);
+}
+
 TEST(Warp, CosineHemisphereChiSquare) {
   const chi2_result r = test::chi2_test_directions(
       [](pcg32& rng, vec3& d) {

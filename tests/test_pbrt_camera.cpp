@@ -8,6 +8,7 @@
 
 #include <cmath>
 
+#include "mcrt/core/rng.hpp"
 #include "pbrt/camera.hpp"
 
 using namespace mcrt;
@@ -69,5 +70,56 @@ TEST(PbrtCamera, AReflectionInTheMatrixMirrorsTheImage) {
     EXPECT_NEAR(t, 0.7f, 1e-5f);
     float s2, t2;
     EXPECT_FALSE(c->project(vec3(1, 2, 3) - c->generate(0.5f, 0.5f).d, s2, t2));  // behind the camera
+  }
+}
+
+// A thin lens (lensradius, focaldistance): every ray of one image point
+// starts on the lens disk around the eye, in the plane through the eye
+// parallel to the image, and passes through the point the pinhole ray of
+// that image point meets on the plane of focus; the lens points are uniform
+// over the disk (mean offset 0, mean squared radius R^2 / 2); a radius of 0
+// is the pinhole camera itself. Also through a mirrored matrix.
+TEST(PbrtCamera, AThinLensFocusesOnThePlaneOfFocus) {
+  const transform look = *transform::look_at({1, 2, 3}, {1, 2, 10}, {0, 1, 0});  // looking along +z
+  for (const transform& m : {look, transform::scale({-1, 1, 1}) * look}) {
+    perspective_params p = with_fov(40);
+    const camera pinhole = perspective_camera(m, p, 64, 48);
+    EXPECT_FALSE(pinhole.has_lens());
+    p.lens_radius = 0.25;
+    p.focal_distance = 6.5;
+    const camera lens = perspective_camera(m, p, 64, 48);
+    ASSERT_TRUE(lens.has_lens());
+    pcg32 rng(3, 5);
+    for (const vec2 st : {vec2(0.5f), vec2(0.1f, 0.9f), vec2(0.97f, 0.02f)}) {
+      const ray pin = pinhole.generate(st.x, st.y);
+      const vec3 focus = pin.o + 6.5f * pin.d;  // camera z = 6.5: the pinhole ray's d has camera z = 1
+      EXPECT_NEAR(focus.z, 3.0f + 6.5f, 1e-4f);
+      glm::dvec3 mean(0.0);
+      double r2 = 0.0;
+      const int n = 20000;
+      for (int i = 0; i < n; ++i) {
+        const ray r = lens.generate(st.x, st.y, rng.uniform2());
+        const vec3 off = r.o - vec3(1, 2, 3);
+        ASSERT_NEAR(off.z, 0.0f, 1e-6f);  // on the lens plane
+        ASSERT_LE(glm::length(off), 0.25f * (1.0f + 1e-5f));
+        // Through the focus point: the ray at camera z = 6.5.
+        const float t = (focus.z - r.o.z) / r.d.z;
+        ASSERT_LT(glm::length(r.o + t * r.d - focus), 1e-4f) << "image point " << st.x << ", " << st.y;
+        mean += glm::dvec3(off);
+        r2 += double(glm::dot(off, off));
+      }
+      // Uniform over the disk: mean 0 (s.e. 0.25 / sqrt(4 n) per axis) and
+      // E r^2 = R^2 / 2 (s.e. R^2 / sqrt(12 n)), each within 5 s.e.
+      EXPECT_LT(std::abs(mean.x / n), 5.0 * 0.25 / std::sqrt(4.0 * n));
+      EXPECT_LT(std::abs(mean.y / n), 5.0 * 0.25 / std::sqrt(4.0 * n));
+      EXPECT_NEAR(r2 / n, 0.0625 / 2.0, 5.0 * 0.0625 / std::sqrt(12.0 * n));
+    }
+    // Radius 0: the pinhole, whatever the lens sample.
+    p.lens_radius = 0.0;
+    const camera none = perspective_camera(m, p, 64, 48);
+    EXPECT_FALSE(none.has_lens());
+    const ray a = none.generate(0.3f, 0.6f, vec2(0.9f, 0.1f)), b = pinhole.generate(0.3f, 0.6f);
+    EXPECT_EQ(a.o, b.o);
+    EXPECT_EQ(a.d, b.d);
   }
 }

@@ -312,6 +312,69 @@ AttributeEnd
   }
 }
 
+// A thin-lens camera (lensradius, focaldistance) over a checkerboard floor
+// lit from above: focused on the floor, its image is the pinhole camera's
+// (every ray of a film point meets the floor where the pinhole ray does,
+// and a diffuse floor sends the same radiance to every lens point), so the
+// two differ by noise alone: their RMS difference is that of two pinhole
+// renders with different seeds, within 25 % (each RMS is estimated from
+// 3 x 576 values: a few % of noise). Focused at pbrt's default 1e6 instead,
+// the lens blurs the checks' edges by its radius (0.25 against checks of
+// 0.25): the difference is over 3 times the noise. Under the independent
+// sampler (whose lens sample comes from the pixel's stream) and Sobol's.
+TEST(PbrtLens, ThePlaneOfFocusIsSharpAndTheRestBlurred) {
+  const auto scene_with = [](const std::string& lens) {
+    return from_text(R"(LookAt 0 3 0  0 0 0  0 0 1
+Camera "perspective" "float fov" 20 )" + lens + R"(
+WorldBegin
+Texture "c" "spectrum" "checkerboard" "float uscale" 40 "float vscale" 40
+    "rgb tex1" [ 0.8 0.8 0.8 ] "rgb tex2" [ 0.1 0.1 0.1 ]
+Material "diffuse" "texture reflectance" "c"
+Shape "trianglemesh" "point3 P" [ -5 0 -5  5 0 -5  5 0 5  -5 0 5 ] "integer indices" [ 0 1 2  0 2 3 ]
+    "point2 uv" [ 0 0  1 0  1 1  0 1 ]
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [ 4 4 4 ]
+  Material "diffuse" "rgb reflectance" [ 0 0 0 ]
+  Shape "trianglemesh" "point3 P" [ -5 4 -5  5 4 -5  5 4 5  -5 4 5 ] "integer indices" [ 0 1 2  0 2 3 ]
+AttributeEnd
+)");
+  };
+  const pbrt::built_scene pinhole = scene_with(""), focused = scene_with(R"("float lensradius" 0.25 "float focaldistance" 3)"),
+                          far = scene_with(R"("float lensradius" 0.25)");
+  ASSERT_DOUBLE_EQ(focused.perspective.lens_radius, 0.25);
+  ASSERT_DOUBLE_EQ(focused.perspective.focal_distance, 3.0);
+  ASSERT_DOUBLE_EQ(far.perspective.focal_distance, 1e6);  // pbrt-v4's default
+  for (const sampler_kind sk : {sampler_kind::independent, sampler_kind::sobol}) {
+    render_settings rs;
+    rs.width = rs.height = 24;
+    rs.spp = 256;
+    rs.max_depth = 1;
+    rs.integrator = integrator_kind::nee;
+    rs.sampler = sk;
+    const auto image_of = [&](const pbrt::built_scene& b, std::uint64_t seed) {
+      rs.seed = seed;
+      const camera cam = pbrt::perspective_camera(b.camera_from_world, b.perspective, rs.width, rs.height);
+      EXPECT_EQ(cam.has_lens(), b.perspective.lens_radius > 0.0);
+      return render(b.world, cam, rs).img;
+    };
+    const image a = image_of(pinhole, 1), b = image_of(pinhole, 2), c = image_of(focused, 3), d = image_of(far, 4);
+    const auto rms = [](const image& x, const image& y) {
+      double s = 0.0;
+      for (std::size_t i = 0; i < x.pixels.size(); ++i) {
+        const glm::dvec3 e = glm::dvec3(x.pixels[i]) - glm::dvec3(y.pixels[i]);
+        s += glm::dot(e, e);
+      }
+      return std::sqrt(s / (3.0 * double(x.pixels.size())));
+    };
+    const double noise = rms(a, b), sharp = rms(c, a), blurred = rms(d, a);
+    const std::string what = std::string(to_string(sk));
+    ASSERT_GT(noise, 0.0) << what;
+    EXPECT_LT(sharp, 1.25 * noise) << what << ": focused " << sharp << ", two pinhole renders " << noise;
+    EXPECT_GT(sharp, 0.8 * noise) << what << ": focused " << sharp << ", two pinhole renders " << noise;
+    EXPECT_GT(blurred, 3.0 * noise) << what << ": out of focus " << blurred << ", two pinhole renders " << noise;
+  }
+}
+
 // A light's emitting material reflects with the shape's own material: a
 // white diffuse emitter lit by another light sends back more than its
 // emission (a black one, nothing more).

@@ -33,6 +33,10 @@ def mitsuba_tree(sc, width, height, spp, max_depth, sampler="independent"):
                        "pixel_format": ("string", "rgb"), "component_format": ("string", "float32"),
                        "sample_border": ("boolean", True),
                        "rfilter": sc.rfilter}}
+    if sc.lens_radius > 0.0:  # the same thin lens: concentric disk samples, focus along camera z
+        sensor["type"] = "thinlens"
+        sensor["aperture_radius"] = ("float", sc.lens_radius)
+        sensor["focus_distance"] = ("float", sc.focal_distance)
     integ = {"type": "path", "max_depth": ("integer", max_depth + 1), "hide_emitters": ("boolean", False)}
     return [("integrator", integ), ("sensor", sensor), *sc.bsdfs.items(), *sc.shapes]
 

@@ -76,6 +76,8 @@ class Scene:
     max_depth: int = 5              # pbrt's maxdepth (mcrt's --max-depth)
     camera_to_world: np.ndarray = None
     fov: float = 90.0
+    lens_radius: float = 0.0        # pbrt's lensradius: Mitsuba's thinlens where > 0
+    focal_distance: float = 1e6     # pbrt's focaldistance (its default 1e6)
     rfilter: dict = field(default_factory=lambda: {"type": "gaussian", "stddev": ("float", 0.5)})
     filter_text: str = "gaussian (pbrt default, radius 1.5, sigma 0.5)"
     bsdfs: dict = field(default_factory=dict)    # id -> node
@@ -279,8 +281,8 @@ class Translator:
             raise PbrtError(f'{d.loc}: Camera "{d.type}": not supported (supported: perspective)')
         p = _Params(d)
         self.scene.fov = float(p.one("fov", 90.0))
-        p.default_only("lensradius", 0.0)
-        p.get("focaldistance")
+        self.scene.lens_radius = float(p.one("lensradius", 0.0))
+        self.scene.focal_distance = float(p.one("focaldistance", 1e6))
         if p.get("screenwindow") is not None or p.get("frameaspectratio") is not None:
             p.fail("screenwindow and frameaspectratio are not translated")
         p.finish()

@@ -319,8 +319,11 @@ class builder {
       if (!(sw->numbers[1] > sw->numbers[0] && sw->numbers[3] > sw->numbers[2])) p.fail(*sw, "must be xmin xmax ymin ymax with xmin < xmax, ymin < ymax");
       pp.screen_window = std::array<double, 4>{sw->numbers[0], sw->numbers[1], sw->numbers[2], sw->numbers[3]};
     }
-    p.accept_default("lensradius", 0.0);
-    p.accept_any("focaldistance");  // no effect without a lens
+    pp.lens_radius = p.real("lensradius", 0.0);
+    if (!(pp.lens_radius >= 0.0 && std::isfinite(pp.lens_radius))) p.fail(*p.find("lensradius"), "must be >= 0");
+    pp.focal_distance = p.real("focaldistance", 1e6);
+    if (!(pp.focal_distance > 0.0 && std::isfinite(pp.focal_distance)))
+      p.fail(*p.find("focaldistance"), "must be > 0");
     p.accept_default("shutteropen", 0.0);
     p.accept_default("shutterclose", 1.0);
     p.finish();

@@ -2,7 +2,16 @@
 // Shirley's pinhole camera ("In One Weekend", sec. 11): vfov is the vertical
 // field of view in degrees; the image's horizontal axis is
 // cross(vup, lookfrom - lookat), its vertical axis vup projected.
+//
+// A camera may also have a thin lens (pbrt-v4's PerspectiveCamera,
+// "Physically Based Rendering", 4th ed., sec. 5.2.3; Shirley's "In One
+// Weekend", sec. 13): a disk around the eye, in the plane through it
+// parallel to the image, and a plane of focus. The ray of image point (s, t)
+// and lens point u then starts at the lens point and passes through the
+// point the pinhole ray of (s, t) meets on the plane of focus, so that the
+// plane of focus is sharp and everything else is blurred by the lens.
 #include "mcrt/core/ray.hpp"
+#include "mcrt/sampling/warp.hpp"
 
 namespace mcrt {
 
@@ -34,12 +43,41 @@ class camera {
     return c;
   }
 
-  // (s, t) in [0,1]^2 over the image, s to the right, t downwards (row order).
+  // A thin lens: lens_x and lens_y are the lens disk's two radii in the
+  // world (the images of the camera's x and y axes scaled by the lens
+  // radius; a camera matrix with a reflection or a scale maps them as it
+  // maps everything else), and the plane of focus is where the pinhole ray
+  // generate(s, t) = o + k d reaches k = focal (pbrt-v4: focaldistance in
+  // camera space, along z, with d's camera-space z equal to 1).
+  void set_thin_lens(const vec3& lens_x, const vec3& lens_y, float focal) {
+    lens_x_ = lens_x;
+    lens_y_ = lens_y;
+    focal_ = focal;
+    has_lens_ = true;
+  }
+  // Whether camera rays need a lens sample (two more sample dimensions).
+  bool has_lens() const { return has_lens_; }
+
+  // (s, t) in [0,1]^2 over the image, s to the right, t downwards (row order):
+  // the pinhole ray through the lens's centre.
   ray generate(float s, float t) const {
     return {origin_, upper_left_ + s * horizontal_ - t * vertical_ - origin_};
   }
 
-  // The inverse of generate: the image coordinates (s, t) of the point p,
+  // The same image point through the lens point of u in [0,1]^2 (uniform
+  // over the lens disk: the concentric map, sampling/warp.hpp); the pinhole
+  // ray where there is no lens. The direction is formed as
+  // focal d - lens offset, never as the difference of two world points, so
+  // a far plane of focus (pbrt-v4's default 1e6) costs no precision.
+  ray generate(float s, float t, vec2 u) const {
+    const vec3 d = upper_left_ + s * horizontal_ - t * vertical_ - origin_;
+    if (!has_lens_) return {origin_, d};
+    const vec2 l = square_to_uniform_disk_concentric(u);
+    const vec3 offset = l.x * lens_x_ + l.y * lens_y_;
+    return {origin_ + offset, focal_ * d - offset};
+  }
+
+  // The inverse of generate(s, t), the pinhole ray: the image coordinates (s, t) of the point p,
   // false where p is not in front of the camera (on or behind the plane
   // through the eye parallel to the image).
   bool project(const vec3& p, float& s, float& t) const {
@@ -57,6 +95,9 @@ class camera {
 
  private:
   vec3 origin_{0.0f}, upper_left_{0.0f}, horizontal_{0.0f}, vertical_{0.0f};
+  vec3 lens_x_{0.0f}, lens_y_{0.0f};
+  float focal_ = 1.0f;
+  bool has_lens_ = false;
 };
 
 }  // namespace mcrt

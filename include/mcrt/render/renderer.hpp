@@ -64,11 +64,14 @@ inline ray pixel_ray(const camera& cam, int x, int y, vec2 j, float inv_w, float
 
 // The camera ray of one sample of pixel (x, y): through the point the
 // filter draws with the sampler's numbers (dimensions 0 and 1); with the
-// default box of radius 0.5, the point of the pixel they give.
+// default box of radius 0.5, the point of the pixel they give. A camera
+// with a thin lens also draws its lens point (dimensions layout::lens and
+// layout::lens + 1).
 template <class PixelSampler>
 ray camera_ray(const camera& cam, PixelSampler& ps, int x, int y, float inv_w, float inv_h,
                const pixel_filter& filter = {}) {
   const vec2 p = filter.film_point(x, y, ps.pixel());
+  if (cam.has_lens()) return cam.generate(p.x * inv_w, p.y * inv_h, ps.get2d(layout::lens));
   return cam.generate(p.x * inv_w, p.y * inv_h);
 }
 

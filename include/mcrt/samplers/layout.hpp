@@ -18,12 +18,18 @@
 //                        samples (cosine hemisphere, fuzz direction)
 //     b + 6              Russian roulette (1-D)
 //
-// The 2-D pairs are (0, 1), (b + 1, b + 2) and (b + 4, b + 5). A draw that a
-// bounce does not need is simply not made: the places of the others do not
-// move.
+//   dims lens, lens + 1  the point on a thin lens (2-D), drawn only by a
+//                        camera with a lens; placed past the dimensions of
+//                        every bounce (2^30, over 10^8 bounces away), so that
+//                        a lens moves none of the others
+//
+// The 2-D pairs are (0, 1), (b + 1, b + 2), (b + 4, b + 5) and (lens, lens + 1).
+// A draw that a bounce does not need is simply not made: the places of the
+// others do not move.
 namespace mcrt::layout {
 
 inline constexpr int pixel = 0;             // 2-D
+inline constexpr int lens = 1 << 30;        // 2-D
 inline constexpr int dims_per_bounce = 7;
 inline constexpr int light_choice = 0;      // offsets within a bounce
 inline constexpr int light = 1;             // 2-D

@@ -26,6 +26,43 @@ inline vec2 cosine_hemisphere_to_square(const vec3& d) {
   return {d.x * d.x + d.y * d.y, phi / two_pi};
 }
 
+// --- uniform disk, Shirley and Chiu's concentric map ("A low distortion map
+// between disk and square", JGT 2(3), 1997; pbrt-v4's
+// SampleUniformDiskConcentric): the square [-1,1]^2's concentric squares go
+// to concentric circles, so strata stay compact (the thin lens).
+inline vec2 square_to_uniform_disk_concentric(vec2 u) {
+  const vec2 o = 2.0f * u - vec2(1.0f);
+  if (o.x == 0.0f && o.y == 0.0f) return {0.0f, 0.0f};  // the centre: atan of 0/0 below
+  float r, theta;
+  if (std::abs(o.x) > std::abs(o.y)) {
+    r = o.x;
+    theta = 0.25f * pi * (o.y / o.x);
+  } else {
+    r = o.y;
+    theta = 0.5f * pi - 0.25f * pi * (o.x / o.y);
+  }
+  return {r * std::cos(theta), r * std::sin(theta)};
+}
+// Density per unit AREA of the disk: 1 / pi inside the unit disk.
+inline float square_to_uniform_disk_concentric_pdf(vec2 p) { return glm::dot(p, p) <= 1.0f ? inv_pi : 0.0f; }
+// The inverse (pbrt-v4's InvertUniformDiskConcentricSample).
+inline vec2 uniform_disk_concentric_to_square(vec2 p) {
+  float theta = std::atan2(p.y, p.x);  // in [-pi, pi]
+  const float r = std::sqrt(p.x * p.x + p.y * p.y);
+  if (theta < -0.25f * pi) theta += two_pi;  // into [-pi/4, 7pi/4)
+  vec2 o;
+  if (theta < 0.25f * pi) {  // the right wedge, |x| > |y|, x > 0
+    o = {r, r * theta / (0.25f * pi)};
+  } else if (theta < 0.75f * pi) {  // top: y > 0
+    o = {r * (0.5f * pi - theta) / (0.25f * pi), r};
+  } else if (theta < 1.25f * pi) {  // left: x < 0
+    o = {-r, -r * (theta - pi) / (0.25f * pi)};
+  } else {  // bottom: y < 0
+    o = {r * (theta - 1.5f * pi) / (0.25f * pi), -r};
+  }
+  return 0.5f * (o + vec2(1.0f));
+}
+
 // --- uniform sphere
 inline vec3 square_to_uniform_sphere(vec2 u) {
   const float z = 1.0f - 2.0f * u.x;
