@@ -1,5 +1,6 @@
 """python -m bench.mitsuba [SCENE.json ...] [options]   (from the repository root)
    python -m bench.mitsuba --pbrt FILE.pbrt [--pbrt ...] [--size W --spp N --max-depth D]
+   python -m bench.mitsuba --pbrt-throughput [--triangles N --size W --spp N --rounds R --ref-spp N]
 
 Compares mcrt's efficiency, 1 / (MSE x render seconds), with Mitsuba 3's path
 tracer on the same scenes. Runs itself with .venv/bin/python (creating .venv
@@ -70,7 +71,34 @@ def parse(argv):
     g.add_argument("--variant", default="scalar_rgb", help="Mitsuba variant (default %(default)s)")
     g.add_argument("--reference", help="an EXR whose mean both images are compared with (e.g. TungstenRender.exr)")
     g.add_argument("--png-width", type=int, default=256, help="width of each of the PNG's three panels")
+    t = p.add_argument_group("throughput on a >= 1M-triangle mesh against Mitsuba's llvm_ad_rgb (see README.md)")
+    t.add_argument("--pbrt-throughput", action="store_true",
+                   help="generate the mesh scene into OUT (default build/mitsuba-throughput) and measure "
+                        "samples/s and efficiency of mcrt and Mitsuba llvm_ad_rgb (and scalar_rgb), interleaved")
+    t.add_argument("--triangles", type=int, default=1_300_000,
+                   help="at least this many mesh triangles (an icosphere: 20 * 4^level; default %(default)s)")
+    t.add_argument("--rounds", type=int, default=3, help="interleaved rounds (default %(default)s)")
+    t.add_argument("--ref-pass-spp", type=int, default=64,
+                   help="spp of each pass of Mitsuba's reference (default %(default)s)")
+    t.add_argument("--no-scalar", action="store_true", help="leave out Mitsuba's scalar_rgb")
+    t.add_argument("--no-profile", action="store_true", help="leave out the perf profile of mcrt")
+    t.add_argument("--profile-spp", type=int, default=64, help="spp of the profiled mcrt render (default %(default)s)")
+    t.add_argument("--perf-freq", type=int, default=499, help="perf sampling frequency, Hz (default %(default)s)")
+    t.add_argument("--wait-idle", type=float, default=0, metavar="MIN",
+                   help="before the rounds, wait up to MIN minutes for the 1-minute load average to fall "
+                        "below --idle-load (default: no wait)")
+    t.add_argument("--idle-load", type=float, default=0.7, help="the load average --wait-idle waits for")
     a = p.parse_args(argv)
+    if a.pbrt_throughput:
+        a.spp = int(a.spp or 16)
+        a.size = a.size or 256
+        a.ref_spp = a.ref_spp or 4096
+        a.max_depth = 5 if a.max_depth is None else a.max_depth
+        a.out = Path(a.out).resolve() if a.out else ROOT / "build" / "mitsuba-throughput"
+        a.mcrt = Path(a.mcrt).resolve()
+        if a.ref_spp % (2 * a.ref_pass_spp):
+            p.error("--ref-spp must be a multiple of 2 x --ref-pass-spp (two halves of whole passes)")
+        return a
     if a.pbrt:
         a.spp_given = a.spp is not None
         a.spp = [int(x) for x in (a.spp or "16").split(",")]
@@ -102,7 +130,10 @@ def parse(argv):
 if __name__ == "__main__":
     bootstrap()
     args = parse(sys.argv[1:])
-    if args.pbrt:
+    if args.pbrt_throughput:
+        from . import pbrt_throughput
+        pbrt_throughput.main(args)
+    elif args.pbrt:
         from . import pbrt_compare
         pbrt_compare.main(args)
     else:
