@@ -70,11 +70,11 @@ class camera {
   // focal d - lens offset, never as the difference of two world points, so
   // a far plane of focus (pbrt-v4's default 1e6) costs no precision.
   ray generate(float s, float t, vec2 u) const {
-    const vec3 d = upper_left_ + s * horizontal_ - t * vertical_ - origin_;
-    if (!has_lens_) return {origin_, d};
+    const ray pinhole = generate(s, t);
+    if (!has_lens_) return pinhole;
     const vec2 l = square_to_uniform_disk_concentric(u);
     const vec3 offset = l.x * lens_x_ + l.y * lens_y_;
-    return {origin_ + offset, focal_ * d - offset};
+    return {origin_ + offset, focal_ * pinhole.d - offset};
   }
 
   // The inverse of generate(s, t), the pinhole ray: the image coordinates (s, t) of the point p,
