@@ -2,6 +2,9 @@
 // box's rotate_y/translate instancing.
 #include <gtest/gtest.h>
 #include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
 #include <iostream>
 #include <limits>
 #include <string>
@@ -420,4 +423,28 @@ TEST(Geometry, OnlyRectanglesWithEdgesAlongTheAxesAreAxisAligned) {
   hit_record rec;
   EXPECT_TRUE(sc.hit({p + vec3(0, 1, 0), {0, -1, 0}}, 1e-4f, infinity, rec));
   EXPECT_NEAR(rec.t, 1.0f, 1e-6f);
+}
+
+// spawn_origin's rounding away from the surface (detail::step_away) is
+// next_float_up for a positive move and next_float_down for a negative one,
+// bit for bit: on zeros of both signs, denormals, normals of every
+// magnitude, the largest floats and infinities.
+TEST(Geometry, SpawnOriginsRoundingStepIsNextFloatUpOrDown) {
+  std::vector<float> values = {0.0f, -0.0f, std::numeric_limits<float>::denorm_min(),
+                               -std::numeric_limits<float>::denorm_min(), std::numeric_limits<float>::min(),
+                               -std::numeric_limits<float>::min(), std::numeric_limits<float>::max(),
+                               -std::numeric_limits<float>::max(), std::numeric_limits<float>::infinity(),
+                               -std::numeric_limits<float>::infinity(), 1.0f, -1.0f, 555.0f, -1e4f};
+  mcrt::pcg32 rng(7, 1);
+  for (int i = 0; i < 100000; ++i) {
+    // Random bit patterns: every exponent alike, NaNs skipped.
+    const float v = std::bit_cast<float>(rng.next_u32());
+    if (!std::isnan(v)) values.push_back(v);
+  }
+  const auto bits = [](float x) { return std::bit_cast<std::uint32_t>(x); };
+  for (const float v : values) {
+    ASSERT_EQ(bits(mcrt::detail::step_away(v, 1e-3f)), bits(mcrt::next_float_up(v))) << v;
+    ASSERT_EQ(bits(mcrt::detail::step_away(v, -1e-3f)), bits(mcrt::next_float_down(v))) << v;
+    ASSERT_EQ(bits(mcrt::detail::step_away(v, 0.0f)), bits(v)) << v;
+  }
 }
