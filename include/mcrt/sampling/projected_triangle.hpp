@@ -63,7 +63,6 @@
 #include "mcrt/geometry/triangle_mesh.hpp"
 #include "mcrt/sampling/light_sample.hpp"
 #include "mcrt/sampling/projected_polygon.hpp"
-#include "mcrt/sampling/projected_rectangle.hpp"
 
 namespace mcrt {
 
@@ -111,124 +110,84 @@ inline triangle_frame make_triangle_frame(const triangle& t) {
 }  // namespace projected_triangle_detail
 
 // Per-receiver set-up of the projected solid angle of a triangle (steps
-// 1-3 of the header), the choice of method, and (with_map) the map.
-class projected_triangle {
+// 1-3 of the header), the choice of method, and (with_map) the map; all
+// but the clip and the per-edge closed forms are projected_light_polygon's
+// (projected_polygon.hpp), shared with the rectangle.
+class projected_triangle : public projected_light_polygon<projected_triangle> {
  public:
-  using method = projected_rectangle::method;
-  // The rectangle's thresholds (projected_rectangle.hpp): largest condition
-  // number of the map's form (~1e-9 relative), and the one below which
-  // Lambert's sum is used without evaluating (C).
-  static constexpr double max_condition = projected_rectangle::max_condition;
-  static constexpr double direct_condition = projected_rectangle::direct_condition;
-
   projected_triangle(const projected_triangle_detail::triangle_frame& f, const vec3& o, const vec3& n,
                      bool with_map = false)
-      : f_(f) {
-    if (!f_.valid) return;
-    const dvec3 d = f_.p0 - dvec3(o);  // exact: a difference of floats in double
-    h_ = -glm::dot(d, f_.ez);
-    foot_ = {glm::dot(d, f_.ex), glm::dot(d, f_.ey)};
+      : projected_light_polygon(f.ex, f.ey, f.ez), q_(f.q), e_(f.e), len_(f.len) {
+    if (!f.valid) return;
+    const dvec3 d = f.p0 - dvec3(o);  // exact: a difference of floats in double
+    h_ = -glm::dot(d, ez_);
+    foot_ = {glm::dot(d, ex_), glm::dot(d, ey_)};
     // One-sided light: o strictly in front (also rejects NaN).
     if (!(h_ > 0.0) || !std::isfinite(h_) || !std::isfinite(foot_.x) || !std::isfinite(foot_.y)) return;
     nd_ = dvec3(n);
     const double nl = glm::length(nd_);
     if (!(nl > 0.0) || !std::isfinite(nl)) return;
     nd_ *= 1.0 / nl;
-    nL_ = {glm::dot(nd_, f_.ex), glm::dot(nd_, f_.ey), glm::dot(nd_, f_.ez)};
+    nL_ = {glm::dot(nd_, ex_), glm::dot(nd_, ey_), glm::dot(nd_, ez_)};
     clip();
     if (count_ < 3) return;
     closed_forms(with_map);
     if (with_map && how_ == method::map) prepare_map();
   }
 
-  method how() const { return how_; }
-  bool valid() const { return how_ != method::none; }
-  // Whether sample_offset() can return a point (with_map given for the map).
-  bool can_sample() const { return how_ == method::area || (how_ == method::map && map_ok_); }
-  // Omega_proj of the visible part (sr, projected; 0 if nothing is visible).
-  double projected_solid_angle() const { return omega_; }
-  // Area of the visible part on the light (the area fallback's normaliser).
-  double visible_area() const { return area_; }
-  int vertex_count() const { return count_; }
-  bool complement() const { return complement_; }
-  // Omega_proj by Lambert's sum, by (C) and by (Z) (0 if not computed).
-  double omega_lambert() const { return omega_lambert_; }
-  double omega_chord() const { return omega_chord_; }
-  double omega_complement() const { return omega_z_; }
-  // Condition numbers of Lambert's form, of (C), and of (Z) (0 if not computed).
-  double condition_lambert() const { return cond_lambert_; }
-  double condition_chord() const { return cond_chord_; }
-  double condition_complement() const { return cond_z_; }
-  double height() const { return h_; }
-
   // u in [0,1)^2 -> point on the triangle minus o (in double); false if
   // there is nothing to sample. Needs with_map for the map.
   bool sample_offset(vec2 u, dvec3& v) const {
     if (how_ == method::area) {
-      v = to_offset(area_sample(dvec2(u)));
+      v = to_offset(fan_sample(dvec2(u)));
       return true;
     }
     if (how_ != method::map || !map_ok_) return false;
-    const dvec3 x = poly_.sample(dvec2(u));
-    const dvec3 dir = x.x * t_ + x.y * b_ + x.z * nd_;
-    const double dz = -glm::dot(dir, f_.ez);
-    if (!(dz > 0.0)) return false;
-    const double t = h_ / dz;
-    v = to_offset(onto_triangle(dvec2(t * glm::dot(dir, f_.ex), t * glm::dot(dir, f_.ey))));
+    dvec2 p;
+    if (!map_point(u, p)) return false;
+    v = to_offset(onto_triangle(p));
     return true;
-  }
-
-  // Density per unit SOLID ANGLE of the unit direction dir whose ray meets
-  // the triangle at distance t: cos(theta) / Omega_proj on the map,
-  // t^3 / (h A_visible) on the area fallback, 0 below the horizon.
-  double pdf_direction(const dvec3& dir, double t) const {
-    if (how_ == method::none) return 0.0;
-    const double c = glm::dot(dir, nd_);
-    if (!(c > 0.0)) return 0.0;
-    if (how_ == method::map) return c / omega_;
-    return t * t * t / (h_ * area_);
   }
 
   // Point o + v of the visible part -> unit square; the inverse of
   // sample_offset() (needs with_map for the map).
   dvec2 invert_offset(const dvec3& v) const {
-    if (how_ == method::area) return area_invert({glm::dot(v, f_.ex), glm::dot(v, f_.ey)});
-    const dvec3 dir = v / glm::length(v);
-    return poly_.invert({glm::dot(dir, t_), glm::dot(dir, b_), glm::dot(dir, nd_)});
+    if (how_ == method::area) return fan_invert({glm::dot(v, ex_), glm::dot(v, ey_)});
+    return map_invert(v);
   }
 
   // Ray o + t dir (dir unit) against the triangle in its frame; t is the
   // distance to the hit. Closed: points on the edges count as inside.
   bool intersect(const dvec3& dir, double& t) const {
     if (!(h_ > 0.0)) return false;
-    const double dz = glm::dot(dir, f_.ez);
+    const double dz = glm::dot(dir, ez_);
     if (!(dz < 0.0)) return false;
     t = h_ / -dz;
-    return inside(dvec2(t * glm::dot(dir, f_.ex), t * glm::dot(dir, f_.ey)) - foot_);
+    return inside(dvec2(t * glm::dot(dir, ex_), t * glm::dot(dir, ey_)) - foot_);
   }
 
  private:
-  static constexpr int max_vertices = projected_polygon::max_vertices;
+  friend class projected_light_polygon<projected_triangle>;
   static constexpr int horizon = 3;  // edge kind of the clipped edge along the horizon
 
   static int next3(int i) { return i == 2 ? 0 : i + 1; }
   // Vertex i of the triangle relative to the foot of o.
-  dvec2 corner(int i) const { return foot_ + f_.q[i]; }
+  dvec2 corner(int i) const { return foot_ + q_[i]; }
   // Vertex k of the clipped polygon, and the difference of two vertices
-  // formed from their triangle vertices (an edge vector) and their offsets.
+  // formed from their triangle vertices (an edge vector, from its own float
+  // difference) and their offsets.
   dvec2 vertex(int k) const { return corner(base_[k]) + off_[k]; }
   dvec2 vertex_difference(int a, int b) const {  // vertex(b) - vertex(a)
     const int ia = base_[a], ib = base_[b];
-    const dvec2 cd = ia == ib ? dvec2(0.0) : ib == next3(ia) ? f_.e[ia] : -f_.e[ib];
+    const dvec2 cd = ia == ib ? dvec2(0.0) : ib == next3(ia) ? e_[ia] : -e_[ib];
     return cd + (off_[b] - off_[a]);
   }
-  dvec3 to_offset(const dvec2& p) const { return p.x * f_.ex + p.y * f_.ey - h_ * f_.ez; }
+  bool on_horizon(int k) const { return kind_[k] == horizon; }
 
   // Whether x (relative to the first vertex) lies in the closed triangle.
   bool inside(const dvec2& x) const {
     using projected_triangle_detail::cross2;
-    return cross2(f_.e[0], x - f_.q[0]) >= 0.0 && cross2(f_.e[1], x - f_.q[1]) >= 0.0 &&
-           cross2(f_.e[2], x - f_.q[2]) >= 0.0;
+    return cross2(e_[0], x - q_[0]) >= 0.0 && cross2(e_[1], x - q_[1]) >= 0.0 && cross2(e_[2], x - q_[2]) >= 0.0;
   }
   // p (relative to the foot of o) unchanged if it lies in the triangle,
   // else its barycentric coordinates clamped to >= 0 and renormalised: a
@@ -238,16 +197,17 @@ class projected_triangle {
     const dvec2 x = p - foot_;
     // Twice the areas opposite vertices 2, 0, 1.
     double w[3];
-    for (int k = 0; k < 3; ++k) w[k] = cross2(f_.e[k], x - f_.q[k]);
+    for (int k = 0; k < 3; ++k) w[k] = cross2(e_[k], x - q_[k]);
     if (w[0] >= 0.0 && w[1] >= 0.0 && w[2] >= 0.0) return p;
     for (double& wk : w) wk = std::max(wk, 0.0);
     const double s = w[0] + w[1] + w[2];
     if (!(s > 0.0)) return corner(0);
-    // Barycentric weight of vertex 1 is w[2] / s, of vertex 2 w[0] / s.
-    return foot_ + (w[2] / s) * f_.q[1] + (w[0] / s) * f_.q[2];
+    // The barycentric weight of vertex 1 is w[2] / s, that of vertex 2 w[0] / s.
+    return foot_ + (w[2] / s) * q_[1] + (w[0] / s) * q_[2];
   }
 
-  // Step 2: the part of the triangle with n . p > 0.
+  // Step 2: the part of the triangle with n . p > 0 (Sutherland-Hodgman,
+  // as projected_rectangle's clip).
   void clip() {
     double z[3];
     for (int i = 0; i < 3; ++i) {
@@ -261,10 +221,10 @@ class projected_triangle {
       const int j = next3(i);
       if (s <= 0.5) {
         base_[k] = i;
-        off_[k] = s * f_.e[i];
+        off_[k] = s * e_[i];
       } else {
         base_[k] = j;
-        off_[k] = -oms * f_.e[i];
+        off_[k] = -oms * e_[i];
       }
       kind_[k] = kind;
       seg_[k] = seg;
@@ -279,29 +239,28 @@ class projected_triangle {
         base_[k] = i;
         off_[k] = {0.0, 0.0};
         kind_[k] = i;
-        seg_[k] = s * f_.len[i];
+        seg_[k] = s * len_[i];
         height_[k] = z[i];
         ++k;
         if (!in_j) add_clip_point(i, s, -z[j] / (z[i] - z[j]), horizon, 0.0);
       } else if (in_j) {
         const double oms = z[j] / (z[j] - z[i]);
-        add_clip_point(i, -z[i] / (z[j] - z[i]), oms, i, oms * f_.len[i]);
+        add_clip_point(i, -z[i] / (z[j] - z[i]), oms, i, oms * len_[i]);
       }
     }
     count_ = k;
   }
 
-  // Step 3: per-edge angles and normals, Lambert, (C), (Z), the choice
-  // (projected_rectangle.hpp, step 3).
+  // Step 3: per-edge angles and normals (the edge planes of the header),
+  // then Lambert, (C), (Z) and the choice (projected_light_polygon::choose).
   void closed_forms(bool with_map) {
-    using namespace projected_rectangle_detail;
     using projected_triangle_detail::cross2;
     const double hh = h_ * h_;
     // Per triangle edge: unit direction, signed line distance c, q and 1/q.
     std::array<dvec2, 3> ue{};
     std::array<double, 3> line{}, r{}, ir{};
     for (int e = 0; e < 3; ++e) {
-      ue[e] = f_.e[e] / f_.len[e];
+      ue[e] = e_[e] / len_[e];
       line[e] = cross2(corner(e), ue[e]);
       r[e] = std::sqrt(hh + line[e] * line[e]);
       ir[e] = 1.0 / r[e];
@@ -338,192 +297,18 @@ class projected_triangle {
       lambert += 0.5 * mz * g;
       lambert_mag += 0.5 * mzmag * g;
     }
-    const bool direct = lambert > 0.0 && lambert_mag <= direct_condition * lambert;
-    // The edge normals in the light frame (the map and (Z) need them).
-    if (with_map || !direct) {
-      for (int k = 0; k < count_; ++k) {
-        if (kind_[k] == horizon) {
-          mL_[k] = nL_;
-        } else {
-          const int e = kind_[k];
-          mL_[k] = dvec3(-h_ * ue[e].y, h_ * ue[e].x, -line[e]) * ir[e];
-        }
-      }
-    }
-    double seg = 0.0, seg_mag = 0.0;
-    if (!direct) {
-      for (int k = 0; k < count_; ++k) {
-        const double iR = 1.0 / std::sqrt(Xs[k] * Xs[k] + Ys[k] * Ys[k]);  // no overflow: squared lengths of the scene
-        sin_[k] = Ys[k] * iR;
-        cos_[k] = Xs[k] * iR;
-        const double amc = arc_minus_chord(gamma_[k], sin_[k]);
-        seg += 0.5 * mz_[k] * amc;
-        seg_mag += 0.5 * mzmags[k] * amc;
-      }
-    }
-    omega_lambert_ = lambert;
-    cond_lambert_ = lambert_mag / lambert;
-    // Visible area (for the fallback): a fan in the light plane.
-    area_ = 0.0;
-    for (int k = 1; k + 1 < count_; ++k) {
-      const dvec2 a = vertex_difference(0, k), b = vertex_difference(0, k + 1);
-      fan_[k] = 0.5 * std::abs(a.x * b.y - a.y * b.x);
-      area_ += fan_[k];
-    }
-    if (!std::isfinite(area_)) area_ = 0.0;
-    if (direct) {
-      how_ = method::map;
-      complement_ = false;
-      omega_ = lambert;
-      return;
-    }
-    // (C): the chord polygon's area vector from the fan of differences
-    // (projected_rectangle.hpp, step 3).
-    dvec3 area_vec(0.0);
-    {
-      const dvec2 p0 = vertex(0);
-      const double l0 = std::sqrt(glm::dot(p0, p0) + hh);
-      const dvec3 v0(p0.x / l0, p0.y / l0, -h_ / l0);
-      dvec3 prev(0.0);
-      for (int k = 1; k < count_; ++k) {
-        const dvec2 pk = vertex(k), dk = vertex_difference(0, k);
-        const double lk = std::sqrt(glm::dot(pk, pk) + hh);
-        // v_k - v_0 = (V_k - V_0) / L_k - V_0 (L_k^2 - L_0^2) / (L_k L_0 (L_k + L_0)),
-        // L_k^2 - L_0^2 = (P_k - P_0) . (P_k + P_0); V_0 = L_0 v0.
-        const double dl = glm::dot(dk, pk + p0) / (lk * (lk + l0));
-        const dvec3 dv = dvec3(dk.x / lk, dk.y / lk, 0.0) - dl * v0;
-        if (k >= 2) area_vec += glm::cross(prev, dv);
-        prev = dv;
-      }
-      area_vec *= 0.5;
-    }
-    const double chord = -glm::dot(nL_, area_vec);
-    omega_chord_ = chord + seg;
-    cond_chord_ = (glm::length(area_vec) + seg_mag) / omega_chord_;
-
-    if (lambert > 0.0 && cond_lambert_ <= max_condition && omega_chord_ > 0.0) {
-      how_ = method::map;
-      complement_ = false;
-      omega_ = omega_chord_;
-      return;
-    }
-    if (decentral && complement_form() && cond_z_ <= max_condition) {
-      how_ = method::map;
-      complement_ = true;
-      omega_ = omega_z_;
-      return;
-    }
-    if (area_ > 0.0) {
-      how_ = method::area;
-      omega_ = omega_chord_ > 0.0 ? omega_chord_ : 0.0;
-    }
+    choose(with_map, lambert, lambert_mag, decentral, Ys, Xs, mzmags, [&] {
+      for (int k = 0; k < count_; ++k)
+        mL_[k] = kind_[k] == horizon ? nL_ : dvec3(-h_ * ue[kind_[k]].y, h_ * ue[kind_[k]].x, -line[kind_[k]]) * ir[kind_[k]];
+    });
   }
 
-  // The complement form (Z) of every edge (projected_polygon.hpp); false if
-  // it has no area.
-  bool complement_form() {
-    double sum = 0.0, mag = 0.0;
-    for (int k = 0; k < count_; ++k) {
-      const int kn = k + 1 == count_ ? 0 : k + 1;
-      // 1 - |m_z| = |n x m|^2 / (1 + |m_z|), the cross product in the light frame.
-      const double omz = glm::dot(glm::cross(nL_, mL_[k]), glm::cross(nL_, mL_[k])) / (1.0 + std::abs(mz_[k]));
-      omz_[k] = kind_[k] == horizon ? 0.0 : omz;
-      const double zp = unit_height(k), zq = unit_height(kn), zz = zp * zq;
-      const double s = sin_[k], c = cos_[k];
-      // Delta phi - gamma = arg((P_xy . Q_xy + i |P_xy x Q_xy|) (cos g - i sin g)),
-      // P_xy . Q_xy = c - zz, |P_xy x Q_xy| = s |m_z| (projected_polygon.hpp).
-      const double im = s * (zz - omz_[k] * c), re = (c - zz) * c + s * s * (1.0 - omz_[k]);
-      const double a = std::atan2(im, re);
-      const double zk = 0.5 * (a + omz_[k] * gamma_[k]);
-      zterm_[k] = (mz_[k] < 0.0 ? 1.0 : -1.0) * zk;
-      sum += zterm_[k];
-      mag += 0.5 * (std::abs(a) + (2.0 * omz_[k] + zz) * gamma_[k]);
-    }
-    omega_z_ = sum;
-    cond_z_ = mag / sum;
-    return sum > 0.0 && std::isfinite(sum);
-  }
-
-  // z / |V| of vertex k (0 for clip points).
-  double unit_height(int k) const {
-    if (height_[k] == 0.0) return 0.0;
-    const dvec2 p = vertex(k);
-    return height_[k] / std::sqrt(glm::dot(p, p) + h_ * h_);
-  }
-
-  // Step 4: the polygon in the receiver's frame (Duff et al. 2017 basis).
-  void prepare_map() {
-    const double sign = std::copysign(1.0, nd_.z);
-    const double a = -1.0 / (sign + nd_.z), bb = nd_.x * nd_.y * a;
-    t_ = {1.0 + sign * nd_.x * nd_.x * a, sign * bb, -sign * nd_.x};
-    b_ = {bb, sign + nd_.y * nd_.y * a, -nd_.y};
-    // The light's axes in the receiver's frame.
-    const dvec3 EX(glm::dot(f_.ex, t_), glm::dot(f_.ex, b_), nL_.x), EY(glm::dot(f_.ey, t_), glm::dot(f_.ey, b_), nL_.y),
-        EZ(glm::dot(f_.ez, t_), glm::dot(f_.ez, b_), nL_.z);
-    poly_.count = count_;
-    poly_.complement = complement_;
-    poly_.condition = complement_ ? cond_z_ : cond_lambert_;
-    for (int k = 0; k < count_; ++k) {
-      const dvec2 p = vertex(k);
-      dvec3 v = p.x * EX + p.y * EY - h_ * EZ;
-      if (height_[k] == 0.0) v.z = 0.0;  // clip points lie on the horizon
-      poly_.v[k] = v / glm::length(v);
-      dvec3 m = mL_[k].x * EX + mL_[k].y * EY + mL_[k].z * EZ;
-      m.z = mz_[k];  // the value every classification used
-      poly_.m[k] = m;
-      poly_.gamma[k] = gamma_[k];
-      poly_.one_minus_mz[k] = complement_ ? omz_[k] : 0.0;
-      poly_.term[k] = complement_ ? zterm_[k] : 0.5 * mz_[k] * gamma_[k];
-    }
-    map_ok_ = poly_.prepare();
-  }
-
-  // Area fallback: uniform on the fan of triangles (v0, v_k, v_k+1) of the
-  // visible polygon (one triangle, Turk's square-root map, when nothing is
-  // clipped; triangle_area.hpp).
-  dvec2 area_sample(dvec2 u) const {
-    double target = u.x * area_;
-    int k = 1;
-    while (k + 2 < count_ && target > fan_[k]) target -= fan_[k++];
-    const double s = std::sqrt(std::clamp(target / fan_[k], 0.0, 1.0));
-    const dvec2 a = vertex_difference(0, k), b = vertex_difference(0, k + 1);
-    return vertex(0) + s * ((1.0 - u.y) * a + u.y * b);
-  }
-  dvec2 area_invert(const dvec2& p) const {
-    // The fan triangle whose barycentric coordinates (al, be) in the basis
-    // (v_k - v_0, v_k+1 - v_0) are least negative; s = al + be, u2 = be / s.
-    const dvec2 q = p - vertex(0);
-    double before = 0.0, best = -infinity, u1 = 1.0, u2 = 1.0;
-    for (int k = 1; k + 1 < count_; ++k) {
-      const dvec2 a = vertex_difference(0, k), b = vertex_difference(0, k + 1);
-      const double det = a.x * b.y - a.y * b.x;
-      const double al = (q.x * b.y - q.y * b.x) / det, be = (a.x * q.y - a.y * q.x) / det;
-      const double inside = std::min({al, be, 1.0 - al - be});
-      if (inside > best) {
-        best = inside;
-        const double s = std::clamp(al + be, 0.0, 1.0);
-        u1 = (before + s * s * fan_[k]) / area_;
-        u2 = al + be > 0.0 ? be / (al + be) : 0.0;
-      }
-      before += fan_[k];
-    }
-    return {std::clamp(u1, 0.0, 1.0), std::clamp(u2, 0.0, 1.0)};
-  }
-
-  projected_triangle_detail::triangle_frame f_;
-  double h_ = 0.0;
+  std::array<dvec2, 3> q_{}, e_{};  // the frame's vertices and edge vectors
+  std::array<double, 3> len_{};
   dvec2 foot_{0.0};  // the first vertex relative to the foot of o, in (ex, ey)
-  dvec3 nd_{0.0, 0.0, 1.0}, nL_{0.0, 0.0, 1.0}, t_{1.0, 0.0, 0.0}, b_{0.0, 1.0, 0.0};
-  int count_ = 0;
   std::array<int, max_vertices> base_{}, kind_{};
   std::array<dvec2, max_vertices> off_{};
-  std::array<dvec3, max_vertices> mL_{};
-  std::array<double, max_vertices> seg_{}, height_{}, gamma_{}, sin_{}, cos_{}, mz_{}, omz_{}, zterm_{}, fan_{};
-  double omega_ = 0.0, omega_lambert_ = 0.0, omega_chord_ = 0.0, omega_z_ = 0.0, area_ = 0.0;
-  double cond_lambert_ = 0.0, cond_chord_ = 0.0, cond_z_ = 0.0;
-  bool complement_ = false, map_ok_ = false;
-  method how_ = method::none;
-  projected_polygon poly_;
+  std::array<double, max_vertices> seg_{};
 };
 
 // Light-sampling strategy: exact projected-solid-angle sampling of a
