@@ -8,10 +8,11 @@
 // [P21]: its projected-solid-angle sampler, with the inversion replaced by a
 // safeguarded Newton iteration in double. The light strategy for rectangles,
 // which clips the rectangle at the horizon and fills this structure, is in
-// projected_rectangle.hpp, the one for triangles in projected_triangle.hpp;
-// what they share (the closed forms of Omega_proj on the clipped polygon,
-// the choice between them, the area fallback and the set-up of the map) is
-// projected_light_polygon at the end of this header.
+// projected_rectangle.hpp. The one for triangles, projected_triangle.hpp,
+// takes the closed forms of Omega_proj on the clipped polygon, the choice
+// between them, the area fallback and the set-up of the map from
+// projected_light_polygon at the end of this header, which evaluates them
+// as projected_rectangle does.
 //
 // Geometry [P21]. Project the hemisphere orthographically onto the unit disk
 // of the tangent plane: the projected solid angle of a set of directions is
@@ -469,15 +470,17 @@ inline double arc_minus_chord(double g, double sin_g) {
 }  // namespace projected_polygon_detail
 
 // The per-receiver state of a planar convex polygon light clipped at the
-// receiver's horizon, shared by the rectangle (projected_rectangle.hpp,
-// whose header derives the forms) and the triangle (projected_triangle.hpp),
-// a base of Shape (which names it a friend). In the light's frame (ex, ey
-// in its plane, ez its front normal, o at the origin, the plane z = -h).
-// The shape clips itself and fills count_, height_ (n . V_k, 0 for clip
-// points) and on_horizon_, and offers vertex(k) (vertex k relative to the
-// foot of o) and vertex_difference(a, b) (vertex(b) - vertex(a), formed
-// without cancellation); it then evaluates per edge the arguments of its
-// arc angle (Y = |V_k x V_k+1|, X = V_k . V_k+1), gamma_, m_z and the
+// receiver's horizon: steps 3 and 4 of projected_rectangle.hpp (whose
+// header derives the forms, and whose class evaluates them the same way)
+// for any such polygon of up to max_vertices vertices, as a base of Shape
+// (which names it a friend; the triangle of projected_triangle.hpp). In
+// the light's frame (ex, ey in its plane, ez its front normal, o at the
+// origin, the plane z = -h). The shape clips itself and fills count_ and
+// height_ (n . V_k, 0 for clip points), and offers vertex(k) (vertex k
+// relative to the foot of o), vertex_difference(a, b) (vertex(b) -
+// vertex(a), formed without cancellation) and on_horizon(k) (edge k runs
+// along the horizon); it then evaluates per edge the arguments of its arc
+// angle (Y = |V_k x V_k+1|, X = V_k . V_k+1), gamma_, m_z and the
 // magnitude of m_z's parts, and calls choose(); the map needs
 // prepare_map() after that.
 template <class Shape>
