@@ -86,7 +86,7 @@ inline triangle_frame make_triangle_frame(const triangle& t) {
   dvec3 p[3] = {dvec3(t.vertex(0)), dvec3(t.vertex(1)), dvec3(t.vertex(2))};
   dvec3 c = glm::cross(p[1] - p[0], p[2] - p[0]);
   const double cl = glm::length(c);
-  if (!(cl > 0.0) || !std::isfinite(cl)) return f;
+  if (!(cl > 0.0) || !std::isfinite(cl)) return f;  // zero area or non-finite vertices
   // The front side is triangle::normal()'s; wind the vertices
   // counter-clockwise seen from it.
   if (glm::dot(c, dvec3(t.normal())) < 0.0) {
@@ -103,6 +103,8 @@ inline triangle_frame make_triangle_frame(const triangle& t) {
   f.e = {f.q[1], in_plane(p[2] - p[1]), -f.q[2]};
   for (int k = 0; k < 3; ++k) f.len[k] = glm::length(f.e[k]);
   f.area = 0.5 * cl;
+  // A triangle too thin for its edge vectors (rounded to the frame) to keep
+  // a positive orientation is degenerate: no sample, pdf 0.
   f.valid = f.len[0] > 0.0 && f.len[1] > 0.0 && f.len[2] > 0.0 && cross2(f.q[1], f.q[2]) > 0.0;
   return f;
 }
@@ -122,7 +124,8 @@ class projected_triangle : public projected_light_polygon<projected_triangle> {
     const dvec3 d = f.p0 - dvec3(o);  // exact: a difference of floats in double
     h_ = -glm::dot(d, ez_);
     foot_ = {glm::dot(d, ex_), glm::dot(d, ey_)};
-    // One-sided light: o strictly in front (also rejects NaN).
+    // One-sided light: o strictly in front; a non-finite o (NaN, or inf
+    // making h or the foot inf) has nothing to sample.
     if (!(h_ > 0.0) || !std::isfinite(h_) || !std::isfinite(foot_.x) || !std::isfinite(foot_.y)) return;
     nd_ = dvec3(n);
     const double nl = glm::length(nd_);
@@ -201,7 +204,7 @@ class projected_triangle : public projected_light_polygon<projected_triangle> {
     if (w[0] >= 0.0 && w[1] >= 0.0 && w[2] >= 0.0) return p;
     for (double& wk : w) wk = std::max(wk, 0.0);
     const double s = w[0] + w[1] + w[2];
-    if (!(s > 0.0)) return corner(0);
+    if (!(s > 0.0)) return corner(0);  // every weight clamped: only for a non-finite point
     // The barycentric weight of vertex 1 is w[2] / s, that of vertex 2 w[0] / s.
     return foot_ + (w[2] / s) * q_[1] + (w[0] / s) * q_[2];
   }
