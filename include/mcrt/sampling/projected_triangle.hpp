@@ -22,7 +22,7 @@
 //     each kept as a vertex of the triangle plus a short offset along an
 //     edge, so that differences of nearby vertices keep their relative
 //     precision.
-//  3. Omega_proj in closed form: Lambert's formula ([P21] sec. 3;
+//  3. Omega_proj in closed form: Lambert's formula (Arvo 1995, eq. 2;
 //     projected_polygon.hpp, (L)) on the clipped polygon. Edge k, on the
 //     line through the vertex A (offset from the foot of o) along the unit
 //     direction e = E_k / |E_k|, lies in a plane through o with the inward
@@ -37,7 +37,7 @@
 //     projected_rectangle.hpp (a small or distant light), or as the
 //     complement form (Z) of projected_polygon.hpp (a thin sliver above a
 //     grazing horizon).
-//  4. The map of projected_polygon.hpp ([P21] sec. 4-5, central and
+//  4. The map of projected_polygon.hpp ([P21]; its central and
 //     decentral cases) in the receiver's frame; the sampled direction is
 //     carried onto the light plane for its distance and, if rounding put
 //     it outside, moved onto the triangle.
