@@ -11,7 +11,7 @@
 // Every random test uses a fixed seed. The chi-square tests run at the
 // per-test level 1 - 0.99^(1/256) ~= 3.9e-5 (support/chi2.hpp: the suite's
 // family-wise level 1 % over at most 256 chi-square tests); this file has
-// 11 of them. Other statistical bounds are stated where they are used.
+// 13 of them. Other statistical bounds are stated where they are used.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -84,7 +84,9 @@ dvec3 rotate(const dvec3& v, const dvec3& rot) {
 }
 
 // Whole lights (central and decentral), clipped ones (3 and 4 visible
-// vertices), ~1e-8, 1e-12 and 1e-14 sr (the last on the area fallback),
+// vertices), ~1e-8, 1e-12 and 1e-14 sr (the last on the area fallback), a
+// small light clipped by a horizon within 0.03 degrees of it (on the area
+// fallback, 4 vertices),
 // near 2 pi (observer 1e-7 above a large triangle), an observer 2e-6 from
 // the light's plane, thin slivers above a grazing horizon (1e-3, 1e-5 and
 // 5e-2 of the width visible), aspect 1e4 (clipped), rotated with a
@@ -110,6 +112,7 @@ std::vector<psa_case> psa_battery() {
       {"tiny_1e8", unit_tri, {0.1f, 0.2f, 5e3f}, unit(0.3, -0.2, -1.0)},
       {"tiny_1e12", unit_tri, {0.1f, 0.2f, 5e5f}, unit(0.3, -0.2, -1.0)},
       {"tiny_1e14", unit_tri, {0.1f, 0.2f, 5e6f}, unit(0.3, -0.2, -1.0)},
+      {"grazing_clip", unit_tri, {0.1f, 0.2f, 1e3f}, unit(1.0, 0.0, -4e-4)},
       {"near_2pi", big, {0.1f, -0.2f, 1e-7f}, {0.0f, 0.0f, -1.0f}},
       {"near_2pi_tilted", big, {0.1f, -0.2f, 1e-7f}, unit(0.5, 0.2, -1.0)},
       {"aspect_clip", strip, {0.0f, 0.0f, 1.0f}, unit(0.3, 0.2, -1.0)},
@@ -316,8 +319,10 @@ TEST(TriangleProjectedSolidAngle, BatteryAgainstLambert) {
   EXPECT_GT(clipped[4], 0);
   EXPECT_GT(whole, 0);
   EXPECT_GT(map, 0);
-  EXPECT_EQ(area, 1);  // tiny_1e14
+  EXPECT_EQ(area, 2);  // tiny_1e14, grazing_clip
   EXPECT_EQ(psa_method(find_case("tiny_1e14")), projected_triangle::method::area);
+  EXPECT_EQ(psa_method(find_case("grazing_clip")), projected_triangle::method::area);
+  EXPECT_EQ(make_pt(find_case("grazing_clip")).vertex_count(), 4);
   EXPECT_GE(complement, 2);  // sliver_1e3, sliver_1e5
   EXPECT_GT(chord, 0);       // tiny_1e12 at least
   EXPECT_GE(double_checked, 9);
@@ -542,7 +547,7 @@ TEST(TriangleProjectedSolidAngle, CosOverPdfIsConstant) {
     }
     EXPECT_LE(worst, 1e-6) << c.name;
   }
-  EXPECT_EQ(cases, 14);  // all but tiny_1e14
+  EXPECT_EQ(cases, 14);  // all but tiny_1e14 and grazing_clip
 }
 
 // ------------------------------------------------------------------ chi-square
@@ -631,6 +636,50 @@ INSTANTIATE_TEST_SUITE_P(Slivers, TriangleProjectedSolidAngleChi2Square,
                          ::testing::Values("plane_1e6", "sliver_1e3", "sliver_1e5"),
                          [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
 
+// The area fallback on the light itself: the points projected_triangle::
+// sample_offset returns (in double: a float direction cannot resolve a
+// light of 1e-14 sr), mapped to the unit square by the inverse of (a, b)
+// -> P0 + a (P1 - P0) + a b (P2 - P1) (area element 2 A a), against the
+// reference density times h / d^3 times 2 A a (2 A a / A_visible on the
+// visible part). 10^6 samples, for the whole tiny light and the clipped
+// grazing one (the fan of the clipped polygon).
+class TriangleAreaFallbackChi2 : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(TriangleAreaFallbackChi2, OnTheLight) {
+  const psa_case c = find_case(GetParam());
+  const projected_triangle pt = make_pt(c, true);
+  ASSERT_EQ(pt.how(), projected_triangle::method::area) << c.name;
+  const psa_reference ref(c);
+  const std::array<dvec3, 3> p = vertices(c.shape);
+  const dvec3 o(c.o), cr = glm::cross(p[1] - p[0], p[2] - p[0]);
+  const double a2 = glm::length(cr);  // 2 A
+  const dvec3 nz = cr / a2;
+  test::chi2_options opt;
+  opt.sample_count = 1'000'000;
+  opt.seed = 29;
+  const auto sample = [&](pcg32& rng, dvec2& ab) {
+    dvec3 v;
+    if (!pt.sample_offset(rng.uniform2(), v)) return false;
+    // Barycentric coordinates of o + v, the offsets from p[0] formed first.
+    const dvec3 q = (o - p[0]) + v;
+    const double b1 = glm::dot(glm::cross(q, p[2] - p[0]), nz) / a2, b2 = glm::dot(glm::cross(p[1] - p[0], q), nz) / a2;
+    const double a = b1 + b2;
+    ab = glm::clamp(dvec2(a, a > 0.0 ? b2 / a : 0.0), dvec2(0.0), dvec2(1.0));
+    return true;
+  };
+  const auto density = [&](const dvec2& ab) {
+    const dvec3 x = p[0] + ab.x * (p[1] - p[0]) + ab.x * ab.y * (p[2] - p[1]);
+    const dvec3 v = x - o;
+    const double d = glm::length(v);
+    return ref(v / d) * ref.h / (d * d * d) * a2 * ab.x;
+  };
+  const test::chi2_result r = test::chi2_test_unit_square(sample, density, opt);
+  EXPECT_TRUE(r.passed) << c.name << "\n" << r.report;
+}
+
+INSTANTIATE_TEST_SUITE_P(Fallback, TriangleAreaFallbackChi2, ::testing::Values("tiny_1e14", "grazing_clip"),
+                         [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
+
 // ------------------------------------------------------------------ round trip
 
 // invert(sample(u)) == u: in double (projected_triangle::sample_offset ->
@@ -653,7 +702,7 @@ TEST(TriangleProjectedSolidAngle, RoundTrip) {
       worst = std::max({worst, std::abs(w.x - u.x), std::abs(w.y - u.y)});
     }
     EXPECT_LE(worst, 1e-6) << c.name;
-    if (c.name.rfind("tiny", 0) == 0 || c.name == "plane_1e6" || c.name.rfind("near_2pi", 0) == 0 ||
+    if (c.name.rfind("tiny", 0) == 0 || c.name == "grazing_clip" || c.name == "plane_1e6" || c.name.rfind("near_2pi", 0) == 0 ||
         c.name.rfind("sliver", 0) == 0 || c.name == "aspect_clip")
       continue;
     const triangle_projected_solid_angle_sampler smp{c.shape};
