@@ -66,6 +66,7 @@
 #include "mcrt/sampling/projected_rectangle.hpp"
 #include "mcrt/sampling/projected_spherical_cap.hpp"
 #include "mcrt/sampling/projected_spherical_ellipse.hpp"
+#include "mcrt/sampling/projected_triangle.hpp"
 #include "mcrt/sampling/rect_area.hpp"
 #include "mcrt/sampling/sphere_area.hpp"
 #include "mcrt/sampling/sphere_cone.hpp"
