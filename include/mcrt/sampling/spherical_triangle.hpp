@@ -1,0 +1,391 @@
+#pragma once
+// Sampling a triangle uniformly in the solid angle it subtends: the
+// area-preserving map from the unit square to the spherical triangle of
+// Arvo 1995, "Stratified Sampling of Spherical Triangles" (SIGGRAPH 95,
+// pp. 437-438), below [Arvo95]; its inverse and its pdf, in the layout of
+// warp.hpp, and the light-sampling strategy triangle_solid_angle_sampler with
+// the interface of light_sample.hpp.
+//
+// The map [Arvo95, sec. 2]. Spherical triangle ABC (the directions from the
+// observer o to the vertices p0, p1, p2), angle alpha at A, sides b = |AC|,
+// c = |AB| (arc lengths), area Omega.
+//  * First stage: the sub-triangle A B C' with C' on the arc AC and area
+//    u1 Omega. [Arvo95] solves for cos |AC'| from Girard's formula (eq. 1)
+//    and the cosine laws for angles (eqs. 2, 3).
+//  * Second stage: the point P on the arc B C' at the angle theta from B with
+//    1 - cos theta = u2 (1 - cos |BC'|) (the arcs from B sweep the
+//    sub-triangle, and the area element along one of them is sin theta
+//    dtheta).
+// The density is 1 / Omega per unit SOLID ANGLE.
+//
+// Numerics. Every quantity is formed in double from the vertices' offsets
+// p_i - o and the edges p_j - p_i, which are exact in double (differences of
+// floats). Where [Arvo95], and code following it, cancel, this header uses
+// equivalent closed forms instead; none of them switches to another density:
+//  * Omega is not Girard's alpha + beta + gamma - pi (eq. 1), which loses all
+//    digits for small triangles, but Van Oosterom & Strackee 1983 ("The
+//    Solid Angle of a Plane Triangle", IEEE Trans. Biomed. Eng. 30(2), eq. 8
+//    of the paper): tan(Omega / 2) = |a.(b x c)| / (abc + (a.b)c + (a.c)b +
+//    (b.c)a) for the offsets a, b, c, with the triple product formed from
+//    the edges, a.((p1 - p0) x (p2 - p0)); one atan2, so also 2 pi - Omega
+//    comes out accurate (atan2 with the denominator negated);
+//  * the first stage in closed form. The area E of a spherical triangle with
+//    sides x, y and included angle alpha satisfies (e.g. Todhunter,
+//    "Spherical Trigonometry", 1886, art. 103)
+//      tan(E/2) = tan(x/2) tan(y/2) sin alpha / (1 + tan(x/2) tan(y/2) cos alpha),
+//    so the sub-triangle of area E = u1 Omega at A with the side c fixed
+//    has its other side b' = |AC'| at
+//      tan(b'/2) = sin(E/2) / (tan(c/2) sin(alpha - E/2)),           (*)
+//    with sin(alpha - E/2) = sin alpha cos(E/2) - cos alpha sin(E/2) by the
+//    addition theorem (E/2 < alpha always: the triangle lies inside the lune
+//    of angle alpha, area 2 alpha). No 1 - cos, no Arvo's sin(A' - alpha)
+//    (which rounds the sub-area u1 Omega against alpha), no acos; sin alpha
+//    comes from the triple product, (a x e_ab) x (a x e_ac) = a (a.(e_ab x
+//    e_ac)), so it keeps its relative precision for slivers;
+//  * the second stage by half angles: sin^2(theta/2) = u2 sin^2(|BC'|/2),
+//    i.e. tan(theta/2) = sqrt(u2) / sqrt(cot^2(|BC'|/2) + 1 - u2), with
+//    cot(|BC'|/2) from a cross and a dot product (cot_half_angle);
+//  * both stages end on the plane of the triangle, not on the sphere: the
+//    ray at the angle phi from the direction of a vertex v towards the
+//    point v + t e of an edge meets it at (plane geometry in the plane of o,
+//    v and e)
+//      t = |v|^2 sin phi / (|v x e| cos phi - (e.v) sin phi),          (**)
+//    (v the vertex's offset from o), with sin phi and cos phi formed from
+//    tan(phi/2) as 2 y / (1 + y^2), (1 - y^2) / (1 + y^2) without a
+//    division by the half-angle's cosine. C' is the point p0 + t (p2 - p0)
+//    of the edge, P the point p1 + s (C' - p1) of the segment from p1: the
+//    sample is the convex combination (1 - s) p1 + s ((1 - t) p0 + t p2), so
+//    it lies on the triangle whatever the rounding once t and s are clamped
+//    to [0, 1], and its distance is exact.
+// The inverse follows the same path backwards: the barycentric coordinates
+// of the ray's hit (triple products), t and s from them, u1 the solid angle
+// of the sub-triangle A B C' over Omega (Van Oosterom-Strackee again), u2 the
+// ratio of the two sin^2 of half angles.
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <numbers>
+
+#include "mcrt/geometry/triangle_mesh.hpp"
+#include "mcrt/sampling/light_sample.hpp"
+
+namespace mcrt {
+
+namespace spherical_triangle_detail {
+
+// cot(theta/2) of the angle theta between two vectors u, v from |u x v|,
+// |u| |v| and u.v: (|u||v| + u.v) / |u x v| when u.v >= 0, otherwise the
+// equal |u x v| / (|u||v| - u.v); either way a sum of non-negative terms
+// (the first form cancels for theta near pi, the second for theta near 0).
+inline double cot_half_angle(double cross_len, double len_product, double dot) {
+  return dot >= 0.0 ? (len_product + dot) / cross_len : cross_len / (len_product - dot);
+}
+// tan(theta/2), the reciprocal, by the same rule.
+inline double tan_half_angle(double cross_len, double len_product, double dot) {
+  return dot >= 0.0 ? cross_len / (len_product + dot) : (len_product - dot) / cross_len;
+}
+// sin^2(theta/2) = (1 - cos theta) / 2 by the same rule: |u x v|^2 /
+// (2 |u||v| (|u||v| + u.v)) when u.v >= 0, (|u||v| - u.v) / (2 |u||v|)
+// otherwise.
+inline double sin2_half_angle(double cross_len, double len_product, double dot) {
+  return dot >= 0.0 ? cross_len * cross_len / (2.0 * len_product * (len_product + dot))
+                    : (len_product - dot) / (2.0 * len_product);
+}
+
+// The numerator |a.(b x c)| and denominator of Van Oosterom & Strackee's
+// tan(Omega/2) for the offsets a, b, c (lengths la, lb, lc) and the triple
+// product `triple` formed from the edges.
+struct vos_terms {
+  double num, den;
+};
+inline vos_terms van_oosterom_strackee(const dvec3& a, const dvec3& b, const dvec3& c, double la, double lb,
+                                       double lc, double triple) {
+  return {std::abs(triple),
+          la * lb * lc + glm::dot(a, b) * lc + glm::dot(a, c) * lb + glm::dot(b, c) * la};
+}
+
+// (p0 - o).((p1 - p0) x (p2 - p0)) in double: negative where o is on the
+// side the winding normal (p1 - p0) x (p2 - p0) points to. One function for
+// the sampler's facing test and the set-up, so both decide alike.
+inline double orientation_triple(const dvec3& o, const dvec3& p0, const dvec3& p1, const dvec3& p2) {
+  return glm::dot(p0 - o, glm::cross(p1 - p0, p2 - p0));
+}
+
+}  // namespace spherical_triangle_detail
+
+// Solid angle (sr) of the triangle p0 p1 p2 seen from o, by Van Oosterom &
+// Strackee 1983 (see the header comment), in [0, 2 pi); relative error a
+// few ulp from the smallest solid angles to within 1e-15 of 2 pi.
+inline double triangle_solid_angle(const dvec3& o, const dvec3& p0, const dvec3& p1, const dvec3& p2) {
+  const dvec3 a = p0 - o, b = p1 - o, c = p2 - o;
+  const double triple = spherical_triangle_detail::orientation_triple(o, p0, p1, p2);
+  const auto t = spherical_triangle_detail::van_oosterom_strackee(a, b, c, glm::length(a), glm::length(b),
+                                                                  glm::length(c), triple);
+  return 2.0 * std::atan2(t.num, t.den);
+}
+
+// Per-observer set-up of the spherical triangle of p0 p1 p2 seen from o, the
+// map [Arvo95] between it and the unit square, and its inverse. Two-sided:
+// valid wherever o is off the triangle's plane (the strategy below adds the
+// one-sided rule). The vertex order fixes the map: A = p0, B = p1, C = p2.
+class spherical_triangle {
+ public:
+  spherical_triangle(const dvec3& o, const dvec3& p0, const dvec3& p1, const dvec3& p2)
+      : p0_(p0), p1_(p1), p2_(p2) {
+    using namespace spherical_triangle_detail;
+    a_ = p0 - o, b_ = p1 - o, c_ = p2 - o;
+    eab_ = p1 - p0, eac_ = p2 - p0;
+    la_ = glm::length(a_), lb_ = glm::length(b_), lc_ = glm::length(c_);
+    triple_ = orientation_triple(o, p0, p1, p2);
+    // In the plane, a degenerate triangle, or NaN: no spherical triangle.
+    if (!(std::abs(triple_) > 0.0) || !std::isfinite(triple_) || !(la_ > 0.0 && lb_ > 0.0 && lc_ > 0.0)) return;
+    const vos_terms w = van_oosterom_strackee(a_, b_, c_, la_, lb_, lc_, triple_);
+    omega_ = 2.0 * std::atan2(w.num, w.den);
+    omega_complement_ = 2.0 * std::atan2(w.num, -w.den);  // 2 pi - Omega, accurate near 2 pi
+    // The angle alpha at A between the planes (o, A, B) and (o, A, C), with
+    // normals a x e_ab and a x e_ac; their cross product is a (a.(e_ab x
+    // e_ac)), so sin alpha = |a| |triple| / (|a x e_ab| |a x e_ac|).
+    const dvec3 nab = glm::cross(a_, eab_), nac = glm::cross(a_, eac_);
+    const double lnab = glm::length(nab);
+    lnac_ = glm::length(nac);
+    const double inv = 1.0 / (lnab * lnac_);
+    sin_alpha_ = la_ * std::abs(triple_) * inv;
+    cos_alpha_ = glm::dot(nab, nac) * inv;
+    tan_half_c_ = tan_half_angle(lnab, la_ * lb_, glm::dot(a_, b_));  // c = |AB|
+    eac_dot_a_ = glm::dot(eac_, a_);
+    valid_ = omega_ > 0.0 && std::isfinite(omega_) && std::isfinite(sin_alpha_) && std::isfinite(cos_alpha_) &&
+             tan_half_c_ > 0.0 && std::isfinite(tan_half_c_);
+  }
+
+  // Whether o is off the plane of a non-degenerate triangle.
+  bool valid() const { return valid_; }
+  // Solid angle subtended at o, in sr (0 when !valid()).
+  double solid_angle() const { return omega_; }
+  // (p0 - o).((p1 - p0) x (p2 - p0)): its sign tells o's side.
+  double triple() const { return triple_; }
+  // Density per unit SOLID ANGLE of the map, 1 / Omega (0 when !valid()).
+  double pdf() const { return valid_ ? 1.0 / omega_ : 0.0; }
+
+  // u in [0,1]^2 -> the point of the triangle minus o, in double. The
+  // direction (normalised) is uniform in the spherical triangle.
+  dvec3 sample_offset(dvec2 u) const {
+    using namespace spherical_triangle_detail;
+    constexpr double half_pi = 0.5 * std::numbers::pi;
+    // ---- First stage, (*): E = u1 Omega, tan(b'/2) = sin(E/2) / M with
+    // M = tan(c/2) sin(alpha - E/2).
+    const double half = 0.5 * u.x * omega_;
+    double sh, ch;  // sin(E/2), cos(E/2)
+    if (half <= half_pi) {
+      sh = std::sin(half), ch = std::cos(half);
+    } else {
+      // pi - E/2 = (2 pi - Omega + (1 - u1) Omega) / 2, a sum of non-negative
+      // terms: sin(E/2) keeps its relative precision as E/2 nears pi.
+      const double rest = 0.5 * (omega_complement_ + (1.0 - u.x) * omega_);
+      sh = std::sin(rest), ch = -std::cos(rest);
+    }
+    const double m = tan_half_c_ * (sin_alpha_ * ch - cos_alpha_ * sh);
+    // (**) on the edge p0 -> p2 (v = a, e = e_ac), with tan(b'/2) = sh / m:
+    // sin b' ~ 2 sh m, cos b' ~ m^2 - sh^2 (the common factor cancels).
+    double t = 1.0;
+    // Guard: m > 0 and a positive denominator hold exactly (E/2 < alpha and
+    // b' <= b, whose ray meets the edge in front of o); rounding can break
+    // them only next to b' = b, the edge's end t = 1, which they default to.
+    if (m > 0.0) {
+      const double num = 2.0 * sh * m * la_ * la_;
+      const double den = lnac_ * (m * m - sh * sh) - 2.0 * sh * m * eac_dot_a_;
+      if (den > 0.0) t = std::min(num / den, 1.0);  // clamp: C' on the edge (rounding past p2)
+    }
+    // ---- Second stage: P on the segment p1 -> C', sin^2(theta/2) =
+    // u2 sin^2(theta_max/2), theta_max = |BC'|. With r = cot(theta_max/2):
+    // tan(theta/2) = Y / Z, Y = sqrt(u2), Z = sqrt(r^2 + 1 - u2), so
+    // sin theta ~ 2 Y Z, cos theta ~ Z^2 - Y^2 = r^2 + 1 - 2 u2.
+    const dvec3 q = a_ + t * eac_;   // C' - o
+    const dvec3 e2 = t * eac_ - eab_;  // C' - p1
+    const double ln2 = glm::length(glm::cross(b_, e2));
+    // Guard: b x (C' - p1) = 0 only with o on the line p1 C', i.e. in the
+    // plane, which valid() excludes; kept against rounding: P = p1.
+    if (!(ln2 > 0.0)) return b_;
+    const double r = cot_half_angle(ln2, lb_ * glm::length(q), glm::dot(b_, q));
+    const double yz2 = 2.0 * std::sqrt(u.y) * std::sqrt(r * r + (1.0 - u.y));  // 2 Y Z
+    // (**) on the segment p1 -> C' (v = b, e = e2); same guard as above.
+    double s = 1.0;
+    const double den = ln2 * (r * r + (1.0 - 2.0 * u.y)) - yz2 * glm::dot(e2, b_);
+    if (den > 0.0) s = std::min(yz2 * lb_ * lb_ / den, 1.0);  // clamp: P on the segment
+    return b_ + s * e2;
+  }
+
+  // The unit direction of sample_offset(u).
+  dvec3 sample_direction(dvec2 u) const { return glm::normalize(sample_offset(u)); }
+
+  // The inverse: a vector v from o whose ray meets the triangle -> u. A ray
+  // that misses by rounding is taken to the nearest point of the edge it
+  // crosses (barycentric coordinates clamped to >= 0).
+  dvec2 invert_offset(const dvec3& v) const {
+    using namespace spherical_triangle_detail;
+    if (!valid_) return {0.0, 0.0};
+    double w0, w1, w2;
+    barycentric(v, w0, w1, w2);
+    // Clamp: project a hit outside by rounding back onto the triangle.
+    w0 = std::max(w0, 0.0), w1 = std::max(w1, 0.0), w2 = std::max(w2, 0.0);
+    const double sum = w0 + w1 + w2;
+    if (!(sum > 0.0)) return {0.0, 0.0};
+    w0 /= sum, w1 /= sum, w2 /= sum;
+    // P = (1 - s) p1 + s ((1 - t) p0 + t p2): s = w0 + w2, t = w2 / s.
+    const double s = w0 + w2;
+    if (!(s > 0.0)) return {0.0, 0.0};  // P = p1: any u1, u2 = 0
+    const double t = std::min(w2 / s, 1.0);
+    const dvec3 q = a_ + t * eac_, e2 = t * eac_ - eab_;
+    const double lq = glm::length(q);
+    // u1: Van Oosterom-Strackee on A B C', whose triple product is t times
+    // the triangle's.
+    const vos_terms sub = van_oosterom_strackee(a_, b_, q, la_, lb_, lq, t * triple_);
+    const double u1 = 2.0 * std::atan2(sub.num, sub.den) / omega_;
+    // u2 = sin^2(theta/2) / sin^2(theta_max/2); b x (P - o) = s b x e2.
+    const dvec3 p = b_ + s * e2;
+    const double ln2 = glm::length(glm::cross(b_, e2));
+    const double top = sin2_half_angle(s * ln2, lb_ * glm::length(p), glm::dot(b_, p));
+    const double bottom = sin2_half_angle(ln2, lb_ * lq, glm::dot(b_, q));
+    const double u2 = bottom > 0.0 ? top / bottom : 0.0;
+    // Clamp: rounding may put either a hair outside [0, 1].
+    return {std::clamp(u1, 0.0, 1.0), std::clamp(u2, 0.0, 1.0)};
+  }
+
+  // Whether the ray o + t dir, t > 0, meets the triangle (edges included),
+  // and where: t_hit. In double, from the signs of the triple products
+  // dir.(b x c), dir.(c x a), dir.(a x b), which are the barycentric
+  // coordinates of the hit times dir.(winding normal).
+  bool hits(const dvec3& dir, double& t_hit) const {
+    if (!valid_) return false;
+    double g0, g1, g2;
+    triple_products(dir, g0, g1, g2);
+    // Inside: all three have the sign of the triangle's triple product.
+    const double sg = triple_ > 0.0 ? 1.0 : -1.0;
+    g0 *= sg, g1 *= sg, g2 *= sg;
+    const double g = g0 + g1 + g2;  // = sg dir.((p1 - p0) x (p2 - p0))
+    if (!(g0 >= 0.0 && g1 >= 0.0 && g2 >= 0.0 && g > 0.0)) return false;
+    t_hit = std::abs(triple_) / g;
+    return std::isfinite(t_hit) && t_hit > 0.0;
+  }
+
+ private:
+  // dir.(b x c), dir.(c x a), dir.(a x b), the cross products formed from
+  // the edges: b x c = b x (p2 - p1), c x a = c x (p0 - p2), a x b = a x (p1 - p0).
+  void triple_products(const dvec3& dir, double& g0, double& g1, double& g2) const {
+    g0 = glm::dot(dir, glm::cross(b_, p2_ - p1_));
+    g1 = glm::dot(dir, glm::cross(c_, p0_ - p2_));
+    g2 = glm::dot(dir, glm::cross(a_, eab_));
+  }
+  // Barycentric coordinates (w0, w1, w2) of the hit of the ray o + t v with
+  // the triangle's plane (unclamped; they sum to 1).
+  void barycentric(const dvec3& v, double& w0, double& w1, double& w2) const {
+    double g0, g1, g2;
+    triple_products(v, g0, g1, g2);
+    const double g = g0 + g1 + g2;
+    w0 = g0 / g, w1 = g1 / g, w2 = g2 / g;
+  }
+
+  dvec3 p0_, p1_, p2_;
+  dvec3 a_{0.0}, b_{0.0}, c_{0.0}, eab_{0.0}, eac_{0.0};
+  double la_ = 0.0, lb_ = 0.0, lc_ = 0.0, lnac_ = 0.0;
+  double triple_ = 0.0, omega_ = 0.0, omega_complement_ = 0.0;
+  double sin_alpha_ = 0.0, cos_alpha_ = 0.0, tan_half_c_ = 0.0, eac_dot_a_ = 0.0;
+  bool valid_ = false;
+};
+
+// The map of [Arvo95] as free functions of the observer and the vertices
+// (A = p0, B = p1, C = p2), after warp.hpp: u -> unit direction, its density
+// per unit SOLID ANGLE 1 / Omega (0 where o is in the triangle's plane; the
+// same for every direction into the triangle), and the inverse.
+inline dvec3 square_to_spherical_triangle(const dvec3& o, const dvec3& p0, const dvec3& p1, const dvec3& p2,
+                                          dvec2 u) {
+  return spherical_triangle(o, p0, p1, p2).sample_direction(u);
+}
+inline double square_to_spherical_triangle_pdf(const dvec3& o, const dvec3& p0, const dvec3& p1, const dvec3& p2) {
+  return spherical_triangle(o, p0, p1, p2).pdf();
+}
+inline dvec2 spherical_triangle_to_square(const dvec3& o, const dvec3& p0, const dvec3& p1, const dvec3& p2,
+                                          const dvec3& dir) {
+  return spherical_triangle(o, p0, p1, p2).invert_offset(dir);
+}
+
+// Light-sampling strategy: uniform in the solid angle of one triangle of a
+// mesh, by spherical_triangle, with the density 1 / Omega per unit solid
+// angle everywhere on the triangle (no fallback). One-sided as
+// triangle_area_sampler: an observer behind the front side (the side
+// triangle::normal() points to) or in the plane gets no sample and pdf 0.
+// The side is decided in double from the exact offsets
+// (orientation_triple), so that it agrees with the spherical triangle's
+// orientation; triangle_area_sampler's float test can decide otherwise only
+// within the float rounding of o and the vertices (~1e-7 of the
+// coordinates) of the plane.
+struct triangle_solid_angle_sampler {
+  triangle shape;
+  // Fixed after construction: the vertices and the front normal.
+  vec3 p0{0.0f}, p1{0.0f}, p2{0.0f}, n{0.0f, 0.0f, 1.0f};
+
+  explicit triangle_solid_angle_sampler(const triangle& t)
+      : shape(t), p0(t.vertex(0)), p1(t.vertex(1)), p2(t.vertex(2)), n(t.normal()) {
+    const dvec3 w = glm::cross(dvec3(p1) - dvec3(p0), dvec3(p2) - dvec3(p0));
+    front_sign_ = glm::dot(w, dvec3(n)) < 0.0 ? 1.0 : -1.0;
+  }
+
+  bool faces(const vec3& o) const {
+    return front_sign_ * spherical_triangle_detail::orientation_triple(dvec3(o), dvec3(p0), dvec3(p1), dvec3(p2)) > 0.0;
+  }
+
+  bool sample(const vec3& o, vec2 u, light_sample& s) const {
+    const spherical_triangle st = set_up(o);
+    if (!st.valid() || !(front_sign_ * st.triple() > 0.0)) return false;
+    const dvec3 v = st.sample_offset(dvec2(u));
+    double t_hit = 0.0;
+    s.dir = vec3(glm::normalize(v));
+    if (!st.hits(dvec3(s.dir), t_hit)) {
+      // The point v lies on the triangle, but its direction rounded to float
+      // may miss it by a hair at the rim: move the point towards the
+      // centroid in growing steps (2^-20, 2^-16, .., 2^-4 of the way, then
+      // all of it) until the float direction hits. Only samples within the
+      // rounding of a float direction (~1e-7 rad) of the rim move, by about
+      // that much; the density stays 1 / Omega.
+      const dvec3 centroid = (dvec3(p0) + dvec3(p1) + dvec3(p2)) / 3.0 - dvec3(o);
+      bool hit = false;
+      for (double lambda = 0x1p-20; lambda <= 1.0 && !hit; lambda = lambda < 0.25 ? 16.0 * lambda : 2.0 * lambda) {
+        const vec3 d(glm::normalize(v + std::min(lambda, 1.0) * (centroid - v)));
+        if (st.hits(dvec3(d), t_hit)) s.dir = d, hit = true;
+      }
+      // No float direction resolves the triangle (it subtends ~1e-7 rad
+      // or less across): the direction towards the sample, its distance.
+      if (!hit) t_hit = glm::length(v);
+    }
+    s.dist = float(t_hit);
+    s.pdf = float(st.pdf());
+    return s.pdf > 0.0f && std::isfinite(s.pdf) && s.dist > 0.0f;
+  }
+
+  // Density per unit SOLID ANGLE at o of the unit direction dir: 1 / Omega
+  // where the ray meets the triangle (edges included, in double) and o
+  // faces its front, 0 elsewhere.
+  float pdf(const vec3& o, const vec3& dir) const {
+    const spherical_triangle st = set_up(o);
+    double t_hit;
+    if (!st.valid() || !(front_sign_ * st.triple() > 0.0) || !st.hits(dvec3(dir), t_hit)) return 0.0f;
+    const float p = float(st.pdf());
+    return std::isfinite(p) ? p : 0.0f;
+  }
+
+  // The inverse of sample(): the unit-square point whose sample has the
+  // direction dir (for a dir that meets the triangle; (0, 0) if o does not
+  // face it).
+  vec2 inverse(const vec3& o, const vec3& dir) const {
+    const spherical_triangle st = set_up(o);
+    if (!st.valid() || !(front_sign_ * st.triple() > 0.0)) return {0.0f, 0.0f};
+    return vec2(st.invert_offset(dvec3(dir)));
+  }
+
+ private:
+  spherical_triangle set_up(const vec3& o) const { return {dvec3(o), dvec3(p0), dvec3(p1), dvec3(p2)}; }
+  // +1 where o faces the front with orientation_triple > 0, i.e. where the
+  // front normal and the winding normal (p1 - p0) x (p2 - p0) disagree.
+  double front_sign_ = -1.0;
+};
+
+}  // namespace mcrt
