@@ -69,6 +69,18 @@
 #include "mcrt/geometry/triangle_mesh.hpp"
 #include "mcrt/sampling/light_sample.hpp"
 
+// Not inlined: the per-observer set-up and the ray test (below) must give
+// bitwise the same Omega and the same hit decision in sample() and pdf() (and
+// wherever else they are called), so that a sample's pdf equals pdf() of its
+// direction. Inlined into different callers, a compiler may contract a * b + c
+// into FMAs differently (GCC's default for GNU C++ is -ffp-contract=fast),
+// and a direction at the rim would hit in one and miss in the other.
+#if defined(__GNUC__)
+#define MCRT_NOINLINE __attribute__((noinline))
+#else
+#define MCRT_NOINLINE
+#endif
+
 namespace mcrt {
 
 namespace spherical_triangle_detail {
@@ -104,11 +116,98 @@ inline vos_terms van_oosterom_strackee(const dvec3& a, const dvec3& b, const dve
           la * lb * lc + glm::dot(a, b) * lc + glm::dot(a, c) * lb + glm::dot(b, c) * la};
 }
 
-// (p0 - o).((p1 - p0) x (p2 - p0)) in double: negative where o is on the
-// side the winding normal (p1 - p0) x (p2 - p0) points to. One function for
-// the sampler's facing test and the set-up, so both decide alike.
+// The error-free transformations below need every product and sum rounded
+// by itself: GCC contracts a * b + c into one FMA across statements by
+// default (-ffp-contract=fast for GNU C++), which would fold the product
+// into the following sum and lose exactly the error term they recover. So
+// these few functions are compiled with contraction off (GCC's per-function
+// optimize pragma; Clang contracts only within one expression by default,
+// and the pragma inside each function keeps it off even under
+// -ffp-contract=fast). They are then not inlined into code compiled with
+// other flags, one call per set-up.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC push_options
+#pragma GCC optimize("fp-contract=off")
+#endif
+#if defined(__clang__)
+#define MCRT_NO_FP_CONTRACT _Pragma("clang fp contract(off)")
+#else
+#define MCRT_NO_FP_CONTRACT
+#endif
+
+// Error-free transformations (Ogita, Rump & Oishi 2005, "Accurate Sum and
+// Dot Product", SIAM J. Sci. Comput. 26(6), algs. 3.1 and 3.3 with an FMA):
+// x y = p + e and x + y = s + e exactly.
+inline void two_product(double x, double y, double& p, double& e) {
+  MCRT_NO_FP_CONTRACT
+  p = x * y;
+  e = std::fma(x, y, -p);
+}
+inline void two_sum(double x, double y, double& s, double& e) {
+  MCRT_NO_FP_CONTRACT
+  s = x + y;
+  const double z = s - x;
+  e = (x - (s - z)) + (y - z);
+}
+
+// u v - w z to within 1.5 ulp of the result whatever the cancellation
+// (Kahan's algorithm with an FMA; Jeannerod, Louvet & Muller 2013).
+inline double difference_of_products(double u, double v, double w, double z) {
+  const double wz = w * z;
+  return std::fma(u, v, -wz) + std::fma(-w, z, wz);
+}
+
+// u x v with every component to 1.5 ulp. The plain formula loses the
+// relative precision of u x v when u and v are nearly parallel (an observer
+// close to the line of an edge: the vertex offset and the edge).
+inline dvec3 cross(const dvec3& u, const dvec3& v) {
+  return {difference_of_products(u.y, v.z, u.z, v.y), difference_of_products(u.z, v.x, u.x, v.z),
+          difference_of_products(u.x, v.y, u.y, v.x)};
+}
+
+// a.(e x f) to a few ulp of the result: each 2x2 minor as an unevaluated
+// sum hi + lo (two_product, two_sum), then the dot product with a in
+// compensated arithmetic (Ogita-Rump-Oishi's Dot2). A triple product
+// rounded in plain double is off by ~eps |a| |e x f|: relative eps |a| / h
+// for an observer at the height h above the plane, which the density and
+// the facing decision would inherit.
+MCRT_NOINLINE inline double triple_product(const dvec3& a, const dvec3& e, const dvec3& f) {
+  MCRT_NO_FP_CONTRACT
+  const auto minor = [](double u, double v, double w, double z, double& hi, double& lo) {
+    double p1, e1, p2, e2, es;
+    two_product(u, v, p1, e1);
+    two_product(w, z, p2, e2);
+    two_sum(p1, -p2, hi, es);
+    lo = es + (e1 - e2);
+  };
+  double hi[3], lo[3];
+  minor(e.y, f.z, e.z, f.y, hi[0], lo[0]);
+  minor(e.z, f.x, e.x, f.z, hi[1], lo[1]);
+  minor(e.x, f.y, e.y, f.x, hi[2], lo[2]);
+  const double ai[3] = {a.x, a.y, a.z};
+  double sum = 0.0, err = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    double p, pe, s, se;
+    two_product(ai[i], hi[i], p, pe);
+    two_sum(sum, p, s, se);
+    sum = s;
+    err += pe + se + ai[i] * lo[i];
+  }
+  return sum + err;
+}
+
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC pop_options
+#endif
+#undef MCRT_NO_FP_CONTRACT
+
+// (p0 - o).((p1 - p0) x (p2 - p0)): negative where o is on the side the
+// winding normal (p1 - p0) x (p2 - p0) points to. The offsets and edges are
+// exact in double (differences of floats), the product accurate
+// (triple_product). One function for the sampler's facing test and the
+// set-up, so both decide alike.
 inline double orientation_triple(const dvec3& o, const dvec3& p0, const dvec3& p1, const dvec3& p2) {
-  return glm::dot(p0 - o, glm::cross(p1 - p0, p2 - p0));
+  return triple_product(p0 - o, p1 - p0, p2 - p0);
 }
 
 }  // namespace spherical_triangle_detail
@@ -130,7 +229,7 @@ inline double triangle_solid_angle(const dvec3& o, const dvec3& p0, const dvec3&
 // one-sided rule). The vertex order fixes the map: A = p0, B = p1, C = p2.
 class spherical_triangle {
  public:
-  spherical_triangle(const dvec3& o, const dvec3& p0, const dvec3& p1, const dvec3& p2)
+  MCRT_NOINLINE spherical_triangle(const dvec3& o, const dvec3& p0, const dvec3& p1, const dvec3& p2)
       : p0_(p0), p1_(p1), p2_(p2) {
     using namespace spherical_triangle_detail;
     a_ = p0 - o, b_ = p1 - o, c_ = p2 - o;
@@ -139,22 +238,30 @@ class spherical_triangle {
     triple_ = orientation_triple(o, p0, p1, p2);
     // In the plane, a degenerate triangle, or NaN: no spherical triangle.
     if (!(std::abs(triple_) > 0.0) || !std::isfinite(triple_) || !(la_ > 0.0 && lb_ > 0.0 && lc_ > 0.0)) return;
-    const vos_terms w = van_oosterom_strackee(a_, b_, c_, la_, lb_, lc_, triple_);
-    omega_ = 2.0 * std::atan2(w.num, w.den);
-    omega_complement_ = 2.0 * std::atan2(w.num, -w.den);  // 2 pi - Omega, accurate near 2 pi
     // The angle alpha at A between the planes (o, A, B) and (o, A, C), with
     // normals a x e_ab and a x e_ac; their cross product is a (a.(e_ab x
-    // e_ac)), so sin alpha = |a| |triple| / (|a x e_ab| |a x e_ac|).
-    const dvec3 nab = glm::cross(a_, eab_), nac = glm::cross(a_, eac_);
+    // e_ac)), so sin alpha = |a| |triple| / (|a x e_ab| |a x e_ac|), with
+    // the relative precision of the triple product also for slivers.
+    const dvec3 nab = cross(a_, eab_), nac = cross(a_, eac_);
     const double lnab = glm::length(nab);
     lnac_ = glm::length(nac);
     const double inv = 1.0 / (lnab * lnac_);
     sin_alpha_ = la_ * std::abs(triple_) * inv;
     cos_alpha_ = glm::dot(nab, nac) * inv;
     tan_half_c_ = tan_half_angle(lnab, la_ * lb_, glm::dot(a_, b_));  // c = |AB|
+    const double tan_half_b = tan_half_angle(lnac_, la_ * lc_, glm::dot(a_, c_));  // b = |AC|
     eac_dot_a_ = glm::dot(eac_, a_);
-    valid_ = omega_ > 0.0 && std::isfinite(omega_) && std::isfinite(sin_alpha_) && std::isfinite(cos_alpha_) &&
-             tan_half_c_ > 0.0 && std::isfinite(tan_half_c_);
+    // Omega from the two sides at A and the angle between them (the formula
+    // of the header comment with E = Omega), equal to Van Oosterom-Strackee's
+    // and computed from the same accurate triple product, but without its
+    // denominator abc + (a.b)c + (a.c)b + (b.c)a, which cancels where two
+    // vertex directions are nearly opposite (o close to the plane and to the
+    // interior of an edge). The same formula inverts the first stage.
+    omega_ = 2.0 * half_sub_area(tan_half_b, false);
+    omega_complement_ = 2.0 * half_sub_area(tan_half_b, true);  // 2 pi - Omega, accurate near 2 pi
+    valid_ = omega_ > 0.0 && std::isfinite(omega_) && std::isfinite(omega_complement_) &&
+             std::isfinite(sin_alpha_) && std::isfinite(cos_alpha_) && tan_half_c_ > 0.0 &&
+             std::isfinite(tan_half_c_);
   }
 
   // Whether o is off the plane of a non-degenerate triangle.
@@ -201,7 +308,7 @@ class spherical_triangle {
     // sin theta ~ 2 Y Z, cos theta ~ Z^2 - Y^2 = r^2 + 1 - 2 u2.
     const dvec3 q = a_ + t * eac_;   // C' - o
     const dvec3 e2 = t * eac_ - eab_;  // C' - p1
-    const double ln2 = glm::length(glm::cross(b_, e2));
+    const double ln2 = glm::length(spherical_triangle_detail::cross(b_, e2));
     // Guard: b x (C' - p1) = 0 only with o on the line p1 C', i.e. in the
     // plane, which valid() excludes; kept against rounding: P = p1.
     if (!(ln2 > 0.0)) return b_;
@@ -236,13 +343,13 @@ class spherical_triangle {
     const double t = std::min(w2 / s, 1.0);
     const dvec3 q = a_ + t * eac_, e2 = t * eac_ - eab_;
     const double lq = glm::length(q);
-    // u1: Van Oosterom-Strackee on A B C', whose triple product is t times
-    // the triangle's.
-    const vos_terms sub = van_oosterom_strackee(a_, b_, q, la_, lb_, lq, t * triple_);
-    const double u1 = 2.0 * std::atan2(sub.num, sub.den) / omega_;
+    // u1 = E / Omega, E the area of A B C' by the first stage's formula
+    // from b' = |AC'| (a x q = t a x e_ac).
+    const double u1 =
+        2.0 * half_sub_area(tan_half_angle(t * lnac_, la_ * lq, glm::dot(a_, q)), false) / omega_;
     // u2 = sin^2(theta/2) / sin^2(theta_max/2); b x (P - o) = s b x e2.
     const dvec3 p = b_ + s * e2;
-    const double ln2 = glm::length(glm::cross(b_, e2));
+    const double ln2 = glm::length(spherical_triangle_detail::cross(b_, e2));
     const double top = sin2_half_angle(s * ln2, lb_ * glm::length(p), glm::dot(b_, p));
     const double bottom = sin2_half_angle(ln2, lb_ * lq, glm::dot(b_, q));
     const double u2 = bottom > 0.0 ? top / bottom : 0.0;
@@ -254,7 +361,7 @@ class spherical_triangle {
   // and where: t_hit. In double, from the signs of the triple products
   // dir.(b x c), dir.(c x a), dir.(a x b), which are the barycentric
   // coordinates of the hit times dir.(winding normal).
-  bool hits(const dvec3& dir, double& t_hit) const {
+  MCRT_NOINLINE bool hits(const dvec3& dir, double& t_hit) const {
     if (!valid_) return false;
     double g0, g1, g2;
     triple_products(dir, g0, g1, g2);
@@ -268,12 +375,23 @@ class spherical_triangle {
   }
 
  private:
+  // Half the area E of the spherical triangle with the sides |AB| = c and
+  // y (tan(y/2) given) enclosing alpha at A:
+  // tan(E/2) = x sin alpha / (1 + x cos alpha), x = tan(y/2) tan(c/2); by
+  // atan2, so E/2 in [0, pi); with complement, pi - E/2 (the denominator
+  // negated), accurate as E/2 nears pi.
+  double half_sub_area(double tan_half_y, bool complement) const {
+    const double x = tan_half_y * tan_half_c_;
+    const double den = 1.0 + x * cos_alpha_;
+    return std::atan2(x * sin_alpha_, complement ? -den : den);
+  }
+
   // dir.(b x c), dir.(c x a), dir.(a x b), the cross products formed from
   // the edges: b x c = b x (p2 - p1), c x a = c x (p0 - p2), a x b = a x (p1 - p0).
   void triple_products(const dvec3& dir, double& g0, double& g1, double& g2) const {
-    g0 = glm::dot(dir, glm::cross(b_, p2_ - p1_));
-    g1 = glm::dot(dir, glm::cross(c_, p0_ - p2_));
-    g2 = glm::dot(dir, glm::cross(a_, eab_));
+    g0 = glm::dot(dir, spherical_triangle_detail::cross(b_, p2_ - p1_));
+    g1 = glm::dot(dir, spherical_triangle_detail::cross(c_, p0_ - p2_));
+    g2 = glm::dot(dir, spherical_triangle_detail::cross(a_, eab_));
   }
   // Barycentric coordinates (w0, w1, w2) of the hit of the ray o + t v with
   // the triangle's plane (unclamped; they sum to 1).
@@ -286,7 +404,7 @@ class spherical_triangle {
 
   dvec3 p0_, p1_, p2_;
   dvec3 a_{0.0}, b_{0.0}, c_{0.0}, eab_{0.0}, eac_{0.0};
-  double la_ = 0.0, lb_ = 0.0, lc_ = 0.0, lnac_ = 0.0;
+  double la_ = 0.0, lb_ = 0.0, lc_ = 0.0, lnac_ = 0.0;  // |a|, |b|, |c|, |a x e_ac|
   double triple_ = 0.0, omega_ = 0.0, omega_complement_ = 0.0;
   double sin_alpha_ = 0.0, cos_alpha_ = 0.0, tan_half_c_ = 0.0, eac_dot_a_ = 0.0;
   bool valid_ = false;
@@ -338,7 +456,7 @@ struct triangle_solid_angle_sampler {
     if (!st.valid() || !(front_sign_ * st.triple() > 0.0)) return false;
     const dvec3 v = st.sample_offset(dvec2(u));
     double t_hit = 0.0;
-    s.dir = vec3(glm::normalize(v));
+    s.dir = to_float_direction(v);
     if (!st.hits(dvec3(s.dir), t_hit)) {
       // The point v lies on the triangle, but its direction rounded to float
       // may miss it by a hair at the rim: move the point towards the
@@ -349,7 +467,7 @@ struct triangle_solid_angle_sampler {
       const dvec3 centroid = (dvec3(p0) + dvec3(p1) + dvec3(p2)) / 3.0 - dvec3(o);
       bool hit = false;
       for (double lambda = 0x1p-20; lambda <= 1.0 && !hit; lambda = lambda < 0.25 ? 16.0 * lambda : 2.0 * lambda) {
-        const vec3 d(glm::normalize(v + std::min(lambda, 1.0) * (centroid - v)));
+        const vec3 d = to_float_direction(v + std::min(lambda, 1.0) * (centroid - v));
         if (st.hits(dvec3(d), t_hit)) s.dir = d, hit = true;
       }
       // No float direction resolves the triangle (it subtends ~1e-7 rad
@@ -382,6 +500,13 @@ struct triangle_solid_angle_sampler {
   }
 
  private:
+  // The unit float direction of v. Not inlined, so that the direction tested
+  // against the triangle is the rounded float one that sample() returns: GCC
+  // 12's SLP vectorizer was seen to forward the double value through a
+  // double -> float -> double round trip (at -O3; not with
+  // -fno-tree-slp-vectorize), which would test an unrounded direction.
+  MCRT_NOINLINE static vec3 to_float_direction(const dvec3& v) { return vec3(glm::normalize(v)); }
+
   spherical_triangle set_up(const vec3& o) const { return {dvec3(o), dvec3(p0), dvec3(p1), dvec3(p2)}; }
   // +1 where o faces the front with orientation_triple > 0, i.e. where the
   // front normal and the winding normal (p1 - p0) x (p2 - p0) disagree.
@@ -389,3 +514,5 @@ struct triangle_solid_angle_sampler {
 };
 
 }  // namespace mcrt
+
+#undef MCRT_NOINLINE
