@@ -90,7 +90,8 @@
 #include "mcrt/geometry/triangle_mesh.hpp"
 #include "mcrt/sampling/light_sample.hpp"
 
-// Not inlined: the per-observer set-up and the ray test (below) must give
+// Not inlined: the per-observer set-up, the triple product and the ray test
+// (below) must give
 // bitwise the same Omega and the same hit decision in sample() and pdf() (and
 // wherever else they are called), so that a sample's pdf equals pdf() of its
 // direction. Inlined into different callers, a compiler may contract a * b + c
@@ -229,6 +230,36 @@ MCRT_NOINLINE inline double triple_product(const dvec3& a, const dvec3& e, const
 // set-up, so both decide alike.
 inline double orientation_triple(const dvec3& o, const dvec3& p0, const dvec3& p1, const dvec3& p2) {
   return triple_product(p0 - o, p1 - p0, p2 - p0);
+}
+
+// dir.(b x c), dir.(c x a), dir.(a x b) for the offsets a, b, c of the
+// vertices p0, p1, p2, the cross products formed from the edges: b x c =
+// b x (p2 - p1), c x a = c x (p0 - p2), a x b = a x (p1 - p0). They are the
+// barycentric coordinates of the hit of the ray along dir times
+// dir.((p1 - p0) x (p2 - p0)).
+inline void edge_triple_products(const dvec3& a, const dvec3& b, const dvec3& c, const dvec3& p0, const dvec3& p1,
+                                 const dvec3& p2, const dvec3& dir, double& g0, double& g1, double& g2) {
+  g0 = glm::dot(dir, cross(b, p2 - p1));
+  g1 = glm::dot(dir, cross(c, p0 - p2));
+  g2 = glm::dot(dir, cross(a, p1 - p0));
+}
+
+// Whether the ray o + t dir, t > 0, meets the triangle (edges included),
+// and where (t_hit), for the offsets a, b, c = p_i - o and the triple
+// product `triple` = orientation_triple(o, p0, p1, p2), nonzero: inside,
+// the three edge_triple_products have its sign. One function (not inlined,
+// see MCRT_NOINLINE) for spherical_triangle::hits and the sampler's pdf().
+MCRT_NOINLINE inline bool ray_hits_triangle(const dvec3& a, const dvec3& b, const dvec3& c, const dvec3& p0,
+                                            const dvec3& p1, const dvec3& p2, double triple, const dvec3& dir,
+                                            double& t_hit) {
+  double g0, g1, g2;
+  edge_triple_products(a, b, c, p0, p1, p2, dir, g0, g1, g2);
+  const double sg = triple > 0.0 ? 1.0 : -1.0;
+  g0 *= sg, g1 *= sg, g2 *= sg;
+  const double g = g0 + g1 + g2;  // = sg dir.((p1 - p0) x (p2 - p0))
+  if (!(g0 >= 0.0 && g1 >= 0.0 && g2 >= 0.0 && g > 0.0)) return false;
+  t_hit = std::abs(triple) / g;
+  return std::isfinite(t_hit) && t_hit > 0.0;
 }
 
 }  // namespace spherical_triangle_detail
@@ -384,17 +415,8 @@ class spherical_triangle {
   // and where: t_hit. In double, from the signs of the triple products
   // dir.(b x c), dir.(c x a), dir.(a x b), which are the barycentric
   // coordinates of the hit times dir.(winding normal).
-  MCRT_NOINLINE bool hits(const dvec3& dir, double& t_hit) const {
-    if (!valid_) return false;
-    double g0, g1, g2;
-    triple_products(dir, g0, g1, g2);
-    // Inside: all three have the sign of the triangle's triple product.
-    const double sg = triple_ > 0.0 ? 1.0 : -1.0;
-    g0 *= sg, g1 *= sg, g2 *= sg;
-    const double g = g0 + g1 + g2;  // = sg dir.((p1 - p0) x (p2 - p0))
-    if (!(g0 >= 0.0 && g1 >= 0.0 && g2 >= 0.0 && g > 0.0)) return false;
-    t_hit = std::abs(triple_) / g;
-    return std::isfinite(t_hit) && t_hit > 0.0;
+  bool hits(const dvec3& dir, double& t_hit) const {
+    return valid_ && spherical_triangle_detail::ray_hits_triangle(a_, b_, c_, p0_, p1_, p2_, triple_, dir, t_hit);
   }
 
  private:
@@ -409,18 +431,11 @@ class spherical_triangle {
     return std::atan2(x * sin_alpha_, complement ? -den : den);
   }
 
-  // dir.(b x c), dir.(c x a), dir.(a x b), the cross products formed from
-  // the edges: b x c = b x (p2 - p1), c x a = c x (p0 - p2), a x b = a x (p1 - p0).
-  void triple_products(const dvec3& dir, double& g0, double& g1, double& g2) const {
-    g0 = glm::dot(dir, spherical_triangle_detail::cross(b_, p2_ - p1_));
-    g1 = glm::dot(dir, spherical_triangle_detail::cross(c_, p0_ - p2_));
-    g2 = glm::dot(dir, spherical_triangle_detail::cross(a_, eab_));
-  }
   // Barycentric coordinates (w0, w1, w2) of the hit of the ray o + t v with
   // the triangle's plane (unclamped; they sum to 1).
   void barycentric(const dvec3& v, double& w0, double& w1, double& w2) const {
     double g0, g1, g2;
-    triple_products(v, g0, g1, g2);
+    spherical_triangle_detail::edge_triple_products(a_, b_, c_, p0_, p1_, p2_, v, g0, g1, g2);
     const double g = g0 + g1 + g2;
     w0 = g0 / g, w1 = g1 / g, w2 = g2 / g;
   }
@@ -505,10 +520,18 @@ struct triangle_solid_angle_sampler {
   // Density per unit SOLID ANGLE at o of the unit direction dir: 1 / Omega
   // where the ray meets the triangle (edges included, in double) and o
   // faces its front, 0 elsewhere.
+  // The facing and ray tests come first, with the functions the set-up
+  // uses, so a direction that misses (most directions a BSDF samples) costs
+  // no set-up.
   float pdf(const vec3& o, const vec3& dir) const {
-    const spherical_triangle st = set_up(o);
+    using namespace spherical_triangle_detail;
+    const dvec3 od(o), q0(p0), q1(p1), q2(p2);
+    const double triple = orientation_triple(od, q0, q1, q2);
     double t_hit;
-    if (!st.valid() || !(front_sign_ * st.triple() > 0.0) || !st.hits(dvec3(dir), t_hit)) return 0.0f;
+    if (!(front_sign_ * triple > 0.0) || !ray_hits_triangle(q0 - od, q1 - od, q2 - od, q0, q1, q2, triple, dvec3(dir), t_hit))
+      return 0.0f;
+    const spherical_triangle st = set_up(o);
+    if (!st.valid()) return 0.0f;
     const float p = float(st.pdf());
     return std::isfinite(p) ? p : 0.0f;
   }
