@@ -73,5 +73,6 @@
 #include "mcrt/sampling/spherical_ellipse.hpp"
 #include "mcrt/sampling/spherical_ellipse_polar.hpp"
 #include "mcrt/sampling/spherical_rectangle.hpp"
+#include "mcrt/sampling/spherical_triangle.hpp"
 #include "mcrt/sampling/triangle_area.hpp"
 #include "mcrt/sampling/warp.hpp"
