@@ -74,33 +74,19 @@ namespace mcrt {
 
 namespace projected_rectangle_detail {
 
-// gamma - sin(gamma) for gamma in [0, pi], with sin(gamma) given: the
-// series gamma^3/6 - gamma^5/120 + ... below 0.25 (truncation < 1e-17
-// relative), the difference above (where it loses < 7 bits).
-inline double arc_minus_chord(double g, double sin_g) {
-  if (g >= 0.25) return g - sin_g;
-  const double g2 = g * g;
-  return g * g2 * (1.0 / 6.0 - g2 * (1.0 / 120.0 - g2 * (1.0 / 5040.0 - g2 * (1.0 / 362880.0 - g2 / 39916800.0))));
-}
+using projected_polygon_detail::arc_minus_chord;  // gamma - sin(gamma), projected_polygon.hpp
 
 }  // namespace projected_rectangle_detail
 
 // Per-receiver set-up of the projected solid angle of a rectangle (steps
-// 1-3 of the header), the choice of method, and (with_map) the map.
-class projected_rectangle {
+// 1-3 of the header), the choice of method, and (with_map) the map; the
+// parts shared with the triangle are projected_light_polygon's
+// (projected_polygon.hpp).
+class projected_rectangle : public projected_light_polygon<projected_rectangle> {
  public:
-  enum class method : unsigned char { none, map, area };
-  // Largest condition number of the map's form (see the header): a few
-  // times 1e6 DBL_EPSILON ~ 1e-9 relative.
-  static constexpr double max_condition = 1e6;
-  // Below this condition number Lambert's sum itself is Omega_proj to a few
-  // times 1e3 DBL_EPSILON < 1e-12 relative, and the cancellation-free form
-  // (C) is not evaluated (a common light seen at a moderate distance).
-  static constexpr double direct_condition = 1e3;
-
   projected_rectangle(const spherical_rectangle_detail::rect_frame& f, const vec3& corner, const vec3& o,
                       const vec3& n, bool with_map = false)
-      : ex_(f.ex), ey_(f.ey), ez_(f.ez), w_(f.w), l_(f.l) {
+      : projected_light_polygon(f.ex, f.ey, f.ez), w_(f.w), l_(f.l) {
     const dvec3 d = dvec3(corner) - dvec3(o);  // exact: a difference of floats in double
     h_ = -glm::dot(d, ez_);
     x0_ = glm::dot(d, ex_);
@@ -121,28 +107,6 @@ class projected_rectangle {
     if (with_map && how_ == method::map) prepare_map();
   }
 
-  method how() const { return how_; }
-  bool valid() const { return how_ != method::none; }
-  // Whether sample_offset() can return a point (with_map given for the map).
-  bool can_sample() const { return how_ == method::area || (how_ == method::map && map_ok_); }
-  // Omega_proj of the visible part (sr, projected; 0 if nothing is visible).
-  double projected_solid_angle() const { return omega_; }
-  // Area of the visible part on the light (the area fallback's normaliser).
-  double visible_area() const { return area_; }
-  int vertex_count() const { return count_; }
-  // Whether the map's sub-areas use the complement form (Z).
-  bool complement() const { return complement_; }
-  // Omega_proj by Lambert's sum, by (C) and by (Z) (0 if not computed).
-  double omega_lambert() const { return omega_lambert_; }
-  double omega_chord() const { return omega_chord_; }
-  double omega_complement() const { return omega_z_; }
-  // Condition numbers of Lambert's form, of (C), and of (Z) (0 if not computed).
-  double condition_lambert() const { return cond_lambert_; }
-  double condition_chord() const { return cond_chord_; }
-  double condition_complement() const { return cond_z_; }
-  double height() const { return h_; }
-  const dvec3& normal() const { return nd_; }
-
   // u in [0,1)^2 -> point on the rectangle minus o (in double); false if
   // there is nothing to sample. Needs with_map for the map.
   bool sample_offset(vec2 u, dvec3& v) const {
@@ -151,34 +115,17 @@ class projected_rectangle {
       return true;
     }
     if (how_ != method::map || !map_ok_) return false;
-    const dvec3 x = poly_.sample(dvec2(u));
-    const dvec3 dir = x.x * t_ + x.y * b_ + x.z * nd_;
-    const double dz = -glm::dot(dir, ez_);
-    if (!(dz > 0.0)) return false;
-    const double t = h_ / dz;
-    const double px = std::clamp(t * glm::dot(dir, ex_), x0_, x1_);
-    const double py = std::clamp(t * glm::dot(dir, ey_), y0_, y1_);
-    v = to_offset({px, py});
+    dvec2 p;
+    if (!map_point(u, p)) return false;
+    v = to_offset({std::clamp(p.x, x0_, x1_), std::clamp(p.y, y0_, y1_)});
     return true;
-  }
-
-  // Density per unit SOLID ANGLE of the unit direction dir whose ray meets
-  // the rectangle at distance t: cos(theta) / Omega_proj on the map,
-  // t^3 / (h A_visible) on the area fallback, 0 below the horizon.
-  double pdf_direction(const dvec3& dir, double t) const {
-    if (how_ == method::none) return 0.0;
-    const double c = glm::dot(dir, nd_);
-    if (!(c > 0.0)) return 0.0;
-    if (how_ == method::map) return c / omega_;
-    return t * t * t / (h_ * area_);
   }
 
   // Point o + v of the visible part -> unit square; the inverse of
   // sample_offset() (needs with_map for the map).
   dvec2 invert_offset(const dvec3& v) const {
     if (how_ == method::area) return area_invert({glm::dot(v, ex_), glm::dot(v, ey_)});
-    const dvec3 dir = v / glm::length(v);
-    return poly_.invert({glm::dot(dir, t_), glm::dot(dir, b_), glm::dot(dir, nd_)});
+    return map_invert(v);
   }
 
   // Ray o + t dir (dir unit) against the rectangle, in the local frame, as
@@ -193,7 +140,8 @@ class projected_rectangle {
   }
 
  private:
-  static constexpr int max_vertices = projected_polygon::max_vertices;
+  friend class projected_light_polygon<projected_rectangle>;
+  bool on_horizon(int k) const { return kind_[k] == horizon; }
   static constexpr int horizon = 4;  // edge kind of the clipped edge along the horizon
 
   // Corner i of the rectangle in the light plane: (x0, y0), (x1, y0), (x1, y1), (x0, y1).
@@ -217,7 +165,6 @@ class projected_rectangle {
     const dvec2 cd((corner_x[base_[b]] - corner_x[base_[a]]) * w_, (corner_y[base_[b]] - corner_y[base_[a]]) * l_);
     return cd + (off_[b] - off_[a]);
   }
-  dvec3 to_offset(const dvec2& p) const { return p.x * ex_ + p.y * ey_ - h_ * ez_; }
 
   // Step 2: the part of the rectangle with n . p > 0.
   void clip() {
@@ -264,12 +211,12 @@ class projected_rectangle {
     whole_ = z[0] > 0.0 && z[1] > 0.0 && z[2] > 0.0 && z[3] > 0.0;
   }
 
-  // Step 3: per-edge angles and normals, Lambert, (C), (Z), the choice.
-  // Where Lambert's sum is used as is (the common case) the density needs
-  // only the arc angles and m_z; the edge normals (for the map) and the
-  // terms of (C) and (Z) are formed only when needed.
+  // Step 3: per-edge angles and normals, then Lambert, (C), (Z) and the
+  // choice (projected_light_polygon::choose). Where Lambert's sum is used
+  // as is (the common case) the density needs only the arc angles and m_z;
+  // the edge normals (for the map) and the terms of (C) and (Z) are formed
+  // only when needed.
   void closed_forms(bool with_map) {
-    using namespace projected_rectangle_detail;
     const double hh = h_ * h_;
     // q0, p1, q1, p0 (distances of the edge lines) and their reciprocals.
     const std::array<double, 4> r = fast_math::sqrt4(hh + y0_ * y0_, hh + x1_ * x1_, hh + y1_ * y1_, hh + x0_ * x0_);
@@ -309,9 +256,8 @@ class projected_rectangle {
       lambert += 0.5 * mz * g;
       lambert_mag += 0.5 * mzmag * g;
     }
-    const bool direct = lambert > 0.0 && lambert_mag <= direct_condition * lambert;
     // The edge normals in the light frame (the map and (Z) need them).
-    if (with_map || !direct) {
+    choose(with_map, lambert, lambert_mag, decentral, Ys, Xs, mzmags, [&] {
       for (int k = 0; k < count_; ++k) {
         if (kind_[k] == horizon) {
           mL_[k] = nL_;
@@ -321,179 +267,25 @@ class projected_rectangle {
           mL_[k] = (e & 1) == 0 ? dvec3(0.0, sg * h_, sg * line) : dvec3(sg * h_, 0.0, sg * line);
         }
       }
-    }
-    double seg = 0.0, seg_mag = 0.0;
-    if (!direct) {
-      for (int k = 0; k < count_; ++k) {
-        const double iR = 1.0 / std::sqrt(Xs[k] * Xs[k] + Ys[k] * Ys[k]);  // no overflow: squared lengths of the scene
-        sin_[k] = Ys[k] * iR;
-        cos_[k] = Xs[k] * iR;
-        const double amc = arc_minus_chord(gamma_[k], sin_[k]);
-        seg += 0.5 * mz_[k] * amc;
-        seg_mag += 0.5 * mzmags[k] * amc;
-      }
-    }
-    omega_lambert_ = lambert;
-    cond_lambert_ = lambert_mag / lambert;
-    // Visible area (for the fallback): a fan in the light plane.
-    area_ = 0.0;
-    for (int k = 1; k + 1 < count_; ++k) {
-      const dvec2 a = vertex_difference(0, k), b = vertex_difference(0, k + 1);
-      fan_[k] = 0.5 * std::abs(a.x * b.y - a.y * b.x);
-      area_ += fan_[k];
-    }
-    if (!std::isfinite(area_)) area_ = 0.0;
-    if (direct) {
-      how_ = method::map;
-      complement_ = false;
-      omega_ = lambert;
-      return;
-    }
-    // (C): the chord polygon's area vector from the fan of differences.
-    dvec3 area_vec(0.0);
-    {
-      const dvec2 p0 = vertex(0);
-      const double l0 = std::sqrt(glm::dot(p0, p0) + h_ * h_);
-      const dvec3 v0(p0.x / l0, p0.y / l0, -h_ / l0);
-      dvec3 prev(0.0);
-      for (int k = 1; k < count_; ++k) {
-        const dvec2 pk = vertex(k), dk = vertex_difference(0, k);
-        const double lk = std::sqrt(glm::dot(pk, pk) + h_ * h_);
-        // v_k - v_0 = (V_k - V_0) / L_k - V_0 (L_k^2 - L_0^2) / (L_k L_0 (L_k + L_0)),
-        // L_k^2 - L_0^2 = (P_k - P_0) . (P_k + P_0); V_0 = L_0 v0.
-        const double dl = glm::dot(dk, pk + p0) / (lk * (lk + l0));
-        const dvec3 dv = dvec3(dk.x / lk, dk.y / lk, 0.0) - dl * v0;
-        if (k >= 2) area_vec += glm::cross(prev, dv);
-        prev = dv;
-      }
-      area_vec *= 0.5;
-    }
-    const double chord = -glm::dot(nL_, area_vec);
-    omega_chord_ = chord + seg;
-    cond_chord_ = (glm::length(area_vec) + seg_mag) / omega_chord_;
-
-    if (lambert > 0.0 && cond_lambert_ <= max_condition && omega_chord_ > 0.0) {
-      how_ = method::map;
-      complement_ = false;
-      omega_ = omega_chord_;
-      return;
-    }
-    if (decentral && complement_form() && cond_z_ <= max_condition) {
-      how_ = method::map;
-      complement_ = true;
-      omega_ = omega_z_;
-      return;
-    }
-    if (area_ > 0.0) {
-      how_ = method::area;
-      omega_ = omega_chord_ > 0.0 ? omega_chord_ : 0.0;
-    }
-  }
-
-  // The complement form (Z) of every edge; false if it has no area.
-  bool complement_form() {
-    double sum = 0.0, mag = 0.0;
-    for (int k = 0; k < count_; ++k) {
-      const int kn = k + 1 == count_ ? 0 : k + 1;
-      // 1 - |m_z| = |n x m|^2 / (1 + |m_z|), the cross product in the light frame.
-      const double omz = glm::dot(glm::cross(nL_, mL_[k]), glm::cross(nL_, mL_[k])) / (1.0 + std::abs(mz_[k]));
-      omz_[k] = kind_[k] == horizon ? 0.0 : omz;
-      const double zp = unit_height(k), zq = unit_height(kn), zz = zp * zq;
-      const double s = sin_[k], c = cos_[k];
-      // Delta phi - gamma = arg((P_xy . Q_xy + i |P_xy x Q_xy|) (cos g - i sin g)),
-      // P_xy . Q_xy = c - zz, |P_xy x Q_xy| = s |m_z| (projected_polygon.hpp).
-      const double im = s * (zz - omz_[k] * c), re = (c - zz) * c + s * s * (1.0 - omz_[k]);
-      const double a = std::atan2(im, re);
-      const double zk = 0.5 * (a + omz_[k] * gamma_[k]);
-      zterm_[k] = (mz_[k] < 0.0 ? 1.0 : -1.0) * zk;
-      sum += zterm_[k];
-      mag += 0.5 * (std::abs(a) + (2.0 * omz_[k] + zz) * gamma_[k]);
-    }
-    omega_z_ = sum;
-    cond_z_ = mag / sum;
-    return sum > 0.0 && std::isfinite(sum);
-  }
-
-  // z / |V| of vertex k (0 for clip points).
-  double unit_height(int k) const {
-    if (height_[k] == 0.0) return 0.0;
-    const dvec2 p = vertex(k);
-    return height_[k] / std::sqrt(glm::dot(p, p) + h_ * h_);
-  }
-
-  // Step 4: the polygon in the receiver's frame (Duff et al. 2017 basis).
-  void prepare_map() {
-    const double sign = std::copysign(1.0, nd_.z);
-    const double a = -1.0 / (sign + nd_.z), bb = nd_.x * nd_.y * a;
-    t_ = {1.0 + sign * nd_.x * nd_.x * a, sign * bb, -sign * nd_.x};
-    b_ = {bb, sign + nd_.y * nd_.y * a, -nd_.y};
-    // The light's axes in the receiver's frame.
-    const dvec3 EX(glm::dot(ex_, t_), glm::dot(ex_, b_), nL_.x), EY(glm::dot(ey_, t_), glm::dot(ey_, b_), nL_.y),
-        EZ(glm::dot(ez_, t_), glm::dot(ez_, b_), nL_.z);
-    poly_.count = count_;
-    poly_.complement = complement_;
-    poly_.condition = complement_ ? cond_z_ : cond_lambert_;
-    for (int k = 0; k < count_; ++k) {
-      const dvec2 p = vertex(k);
-      dvec3 v = p.x * EX + p.y * EY - h_ * EZ;
-      if (height_[k] == 0.0) v.z = 0.0;  // clip points lie on the horizon
-      poly_.v[k] = v / glm::length(v);
-      dvec3 m = mL_[k].x * EX + mL_[k].y * EY + mL_[k].z * EZ;
-      m.z = mz_[k];  // the value every classification used
-      poly_.m[k] = m;
-      poly_.gamma[k] = gamma_[k];
-      poly_.one_minus_mz[k] = complement_ ? omz_[k] : 0.0;
-      poly_.term[k] = complement_ ? zterm_[k] : 0.5 * mz_[k] * gamma_[k];
-    }
-    map_ok_ = poly_.prepare();
+    });
   }
 
   // Area fallback: uniform on the rectangle when it is whole, else on the
   // fan of triangles (v0, v_k, v_k+1) of the visible polygon.
   dvec2 area_sample(dvec2 u) const {
     if (whole_) return {x0_ + u.x * w_, y0_ + u.y * l_};
-    double target = u.x * area_;
-    int k = 1;
-    while (k + 2 < count_ && target > fan_[k]) target -= fan_[k++];
-    const double s = std::sqrt(std::clamp(target / fan_[k], 0.0, 1.0));
-    const dvec2 a = vertex_difference(0, k), b = vertex_difference(0, k + 1);
-    return vertex(0) + s * ((1.0 - u.y) * a + u.y * b);
+    return fan_sample(u);
   }
   dvec2 area_invert(const dvec2& p) const {
     if (whole_) return {std::clamp((p.x - x0_) / w_, 0.0, 1.0), std::clamp((p.y - y0_) / l_, 0.0, 1.0)};
-    // The fan triangle whose barycentric coordinates (al, be) in the basis
-    // (v_k - v_0, v_k+1 - v_0) are least negative; s = al + be, u2 = be / s.
-    const dvec2 q = p - vertex(0);
-    double before = 0.0, best = -infinity, u1 = 1.0, u2 = 1.0;
-    for (int k = 1; k + 1 < count_; ++k) {
-      const dvec2 a = vertex_difference(0, k), b = vertex_difference(0, k + 1);
-      const double det = a.x * b.y - a.y * b.x;
-      const double al = (q.x * b.y - q.y * b.x) / det, be = (a.x * q.y - a.y * q.x) / det;
-      const double inside = std::min({al, be, 1.0 - al - be});
-      if (inside > best) {
-        best = inside;
-        const double s = std::clamp(al + be, 0.0, 1.0);
-        u1 = (before + s * s * fan_[k]) / area_;
-        u2 = al + be > 0.0 ? be / (al + be) : 0.0;
-      }
-      before += fan_[k];
-    }
-    return {std::clamp(u1, 0.0, 1.0), std::clamp(u2, 0.0, 1.0)};
+    return fan_invert(p);
   }
 
-  dvec3 ex_, ey_, ez_;
-  double w_ = 0.0, l_ = 0.0, x0_ = 0.0, x1_ = 0.0, y0_ = 0.0, y1_ = 0.0, h_ = 0.0;
-  dvec3 nd_{0.0, 0.0, 1.0}, nL_{0.0, 0.0, 1.0}, t_{1.0, 0.0, 0.0}, b_{0.0, 1.0, 0.0};
-  int count_ = 0;
+  double w_ = 0.0, l_ = 0.0, x0_ = 0.0, x1_ = 0.0, y0_ = 0.0, y1_ = 0.0;
   std::array<int, max_vertices> base_{}, kind_{};
   std::array<dvec2, max_vertices> off_{};
-  std::array<dvec3, max_vertices> mL_{};
-  std::array<double, max_vertices> seg_{}, height_{}, gamma_{}, sin_{}, cos_{}, mz_{}, omz_{}, zterm_{}, fan_{};
-  double omega_ = 0.0, omega_lambert_ = 0.0, omega_chord_ = 0.0, omega_z_ = 0.0, area_ = 0.0;
-  double cond_lambert_ = 0.0, cond_chord_ = 0.0, cond_z_ = 0.0;
-  bool complement_ = false, map_ok_ = false, whole_ = false;  // whole_: nothing clipped
-  method how_ = method::none;
-  projected_polygon poly_;
+  std::array<double, max_vertices> seg_{};
+  bool whole_ = false;  // nothing clipped
 };
 
 // Light-sampling strategy: exact projected-solid-angle sampling of a
