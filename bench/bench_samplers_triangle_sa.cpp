@@ -1,15 +1,27 @@
-// Cost of solid-angle sampling of a triangle (Arvo 1995, in the closed forms
-// of sampling/spherical_triangle.hpp) against uniform area sampling of the
-// same triangle (sampling/triangle_area.hpp): sample plus pdf per call, on
-// the observers of the samplers' benchmark (bench/observers.hpp) around one
-// half of the Cornell box light, front -y.
+// Cost of the triangle light strategies: sample plus pdf per call, on the
+// observers of the samplers' benchmark (bench/observers.hpp) around one
+// half of the Cornell box light, front -y:
+//  BM_SampleTriangleArea          triangle_area_sampler
+//  BM_SampleTriangleSolidAngle    triangle_solid_angle_sampler (Arvo 1995 in
+//                                 the closed forms of spherical_triangle.hpp)
+//  BM_FloorPbrtSphericalTriangle  pbrt-v4's SampleSphericalTriangle as
+//                                 published (float, pbrt_spherical_triangle_
+//                                 port.inc), its pdf 1/Omega from the same
+//                                 call: the floor of the published algorithm
+//  BM_SampleTriangle{ProjectedSolidAngle,Bilinear,Pbrt}/Up
+//                                 the cosine-aware ones, receiver normal
+//                                 (0, 1, 0) (the light above every horizon)
 #include <benchmark/benchmark.h>
 
 #include <memory>
 
+#include "mcrt/sampling/bilinear_spherical_triangle.hpp"
+#include "mcrt/sampling/pbrt_strategy.hpp"
+#include "mcrt/sampling/projected_triangle.hpp"
 #include "mcrt/sampling/spherical_triangle.hpp"
 #include "mcrt/sampling/triangle_area.hpp"
 #include "observers.hpp"
+#include "pbrt_spherical_triangle_port.inc"
 
 namespace {
 
@@ -38,5 +50,55 @@ void BM_SampleTriangleArea(benchmark::State& state) {
   mcrt::bench::run_sample_and_pdf(state, sampler, triangle_observers(t));
 }
 BENCHMARK(BM_SampleTriangleArea);
+
+void BM_FloorPbrtSphericalTriangle(benchmark::State& state) {
+  const mcrt::triangle t = cornell_half_triangle();
+  const std::vector<mcrt::vec3> obs = triangle_observers(t);
+  const mcrt::vec3 p0 = t.vertex(0), p1 = t.vertex(1), p2 = t.vertex(2);
+  mcrt::pcg32 rng(1, 2);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    float pdf;
+    const mcrt::vec3 d =
+        mcrt::bench::pbrt_port::sample_spherical_triangle(p0, p1, p2, obs[i++ & (obs.size() - 1)], rng.uniform2(), pdf);
+    benchmark::DoNotOptimize(d);
+    benchmark::DoNotOptimize(pdf);
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_FloorPbrtSphericalTriangle);
+
+// As bench::run_sample_and_pdf, with the receiver normal (0, 1, 0).
+template <class Sampler>
+void run_up(benchmark::State& state, const Sampler& sampler, const std::vector<mcrt::vec3>& obs) {
+  const mcrt::vec3 n(0.0f, 1.0f, 0.0f);
+  mcrt::pcg32 rng(1, 2);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const mcrt::vec3& o = obs[i++ & (obs.size() - 1)];
+    mcrt::light_sample s;
+    if (sampler.sample(o, n, rng.uniform2(), s)) benchmark::DoNotOptimize(sampler.pdf(o, n, s.dir));
+    benchmark::DoNotOptimize(s);
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+
+void BM_SampleTriangleProjectedSolidAngle(benchmark::State& state) {
+  const mcrt::triangle t = cornell_half_triangle();
+  run_up(state, mcrt::triangle_projected_solid_angle_sampler{t}, triangle_observers(t));
+}
+BENCHMARK(BM_SampleTriangleProjectedSolidAngle)->Name("BM_SampleTriangleProjectedSolidAngle/Up");
+
+void BM_SampleTriangleBilinear(benchmark::State& state) {
+  const mcrt::triangle t = cornell_half_triangle();
+  run_up(state, mcrt::triangle_bilinear_solid_angle_sampler{t}, triangle_observers(t));
+}
+BENCHMARK(BM_SampleTriangleBilinear)->Name("BM_SampleTriangleBilinear/Up");
+
+void BM_SampleTrianglePbrt(benchmark::State& state) {
+  const mcrt::triangle t = cornell_half_triangle();
+  run_up(state, mcrt::triangle_pbrt_sampler{t}, triangle_observers(t));
+}
+BENCHMARK(BM_SampleTrianglePbrt)->Name("BM_SampleTrianglePbrt/Up");
 
 }  // namespace

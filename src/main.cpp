@@ -284,10 +284,11 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--threads", ro.threads, "Threads (default: all hardware threads)");
   render_cmd->add_option("--light-sampling", ro.light_sampling,
                          "Sample every light by area, solid-angle, projected-solid-angle (cosine-aware), "
-                         "bilinear-solid-angle (comparison: bilinear cosine pre-warp) or auto (per light and shading "
-                         "point, the strategy expected to pay best) (default: each light's own; area for rectangles "
-                         "and ellipses, solid-angle for spheres)")
-      ->check(CLI::IsMember({"area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle", "auto"}));
+                         "bilinear-solid-angle (comparison: bilinear cosine pre-warp), pbrt (pbrt-v4's choice per shape, "
+                         "thresholds included) or auto (per light and shading point, the strategy expected to pay best) "
+                         "(default: each light's own; area for rectangles, ellipses and triangles, solid-angle for "
+                         "spheres)")
+      ->check(CLI::IsMember({"area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle", "pbrt", "auto"}));
   render_cmd->add_option("--auto-rest-cost", ro.auto_rest_cost,
                          "--light-sampling auto: the rest of the path's time per light sample, ns (default: modelled from the "
                          "pilot's rays per light sample; 265 with --auto-rest-variance)");
@@ -326,7 +327,7 @@ int main(int argc, char** argv) {
   samples_cmd->add_option("--from", sop.from, "The receiving point X,Y,Z")->required();
   samples_cmd->add_option("--normal", sop.normal, "The receiving surface's normal X,Y,Z")->required();
   samples_cmd->add_option("--light-sampling", sop.light_sampling, "Strategy (default: the light's own)")
-      ->check(CLI::IsMember({"area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle", "auto"}));
+      ->check(CLI::IsMember({"area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle", "pbrt", "auto"}));
   samples_cmd->add_option("--ellipse-map", sop.ellipse_map, "Map of the spherical ellipse (default parallel)")
       ->check(CLI::IsMember({"parallel", "polar"}));
   samples_cmd->add_option("--n", sop.n, "Number of samples (default 100000)");

@@ -213,6 +213,9 @@ std::pair<float, float> interval(const reader& rd, const json& o, const std::str
 // without the named strategy keeps the closest one it has: a sphere asked
 // for bilinear-solid-angle (a pre-warp of a planar light's map) gets its
 // exact projected-solid-angle map, which that pre-warp approximates.
+// `pbrt` is pbrt-v4's choice for the shape (sampling/pbrt_strategy.hpp):
+// rect_pbrt_sampler for rectangles, the cone for spheres, area sampling for
+// ellipses (pbrt-v4's disks).
 void add_light(scene& world, const rect& s, std::uint32_t mat, std::optional<light_sampling> strategy, ellipse_map,
                const auto_params& ap) {
   switch (strategy.value_or(light_sampling::area)) {
@@ -221,6 +224,7 @@ void add_light(scene& world, const rect& s, std::uint32_t mat, std::optional<lig
     case light_sampling::projected_solid_angle: world.add_light(rect_projected_solid_angle_sampler{s}, mat); return;
     case light_sampling::bilinear_solid_angle: world.add_light(rect_bilinear_solid_angle_sampler{s}, mat); return;
     case light_sampling::automatic: world.add_light(rect_auto_sampler{s, ap}, mat); return;
+    case light_sampling::pbrt: world.add_light(rect_pbrt_sampler{s}, mat); return;
   }
 }
 void add_light(scene& world, const ellipse& s, std::uint32_t mat, std::optional<light_sampling> strategy,
@@ -236,6 +240,7 @@ void add_light(scene& world, const ellipse& s, std::uint32_t mat, std::optional<
     case light_sampling::projected_solid_angle: world.add_light(ellipse_projected_solid_angle_sampler{s}, mat); return;
     case light_sampling::bilinear_solid_angle: world.add_light(ellipse_bilinear_solid_angle_sampler{s}, mat); return;
     case light_sampling::automatic: world.add_light(ellipse_auto_sampler{s, ap}, mat); return;
+    case light_sampling::pbrt: world.add_light(ellipse_area_sampler{s}, mat); return;
   }
 }
 void add_light(scene& world, const sphere& s, std::uint32_t mat, std::optional<light_sampling> strategy, ellipse_map,
@@ -246,6 +251,7 @@ void add_light(scene& world, const sphere& s, std::uint32_t mat, std::optional<l
     case light_sampling::projected_solid_angle:
     case light_sampling::bilinear_solid_angle: world.add_light(sphere_projected_solid_angle_sampler{s}, mat); return;
     case light_sampling::automatic: world.add_light(sphere_auto_sampler{s, ap}, mat); return;
+    case light_sampling::pbrt: world.add_light(sphere_cone_sampler{s}, mat); return;
   }
 }
 
@@ -253,11 +259,11 @@ void add_light(scene& world, const sphere& s, std::uint32_t mat, std::optional<l
 // name that is not a strategy.
 std::optional<light_sampling> strategy_named(const std::string& value) {
   for (const light_sampling s : {light_sampling::area, light_sampling::solid_angle, light_sampling::projected_solid_angle,
-                                 light_sampling::bilinear_solid_angle, light_sampling::automatic})
+                                 light_sampling::bilinear_solid_angle, light_sampling::automatic, light_sampling::pbrt})
     if (value == to_string(s)) return s;
   return std::nullopt;
 }
-constexpr const char* strategy_names = "area, solid-angle, projected-solid-angle, bilinear-solid-angle or auto";
+constexpr const char* strategy_names = "area, solid-angle, projected-solid-angle, bilinear-solid-angle, pbrt or auto";
 
 void read_object(const reader& rd, const json& o, const std::string& path, scene& world,
                  const std::map<std::string, std::uint32_t>& material_ids,

@@ -12,7 +12,9 @@
 #include <fstream>
 #include <iterator>
 #include <numbers>
+#include <optional>
 #include <string>
+#include <tuple>
 
 #include "pbrt/builder.hpp"
 #include "scene_loader.hpp"
@@ -34,11 +36,13 @@ fs::path scratch(const std::string& name) {
   return d;
 }
 
-pbrt::built_scene from_text(const std::string& text, const std::string& dir = "") {
+pbrt::built_scene from_text(const std::string& text, const std::string& dir = "",
+                            std::optional<light_sampling> strategy = std::nullopt) {
   pbrt::parse_options po;
   po.search_directory = dir;
   pbrt::build_options bo;
   bo.decode_image = cli::decode_texture_image;
+  bo.strategy = strategy;
   return pbrt::build_scene(pbrt::parse_text(text, "test.pbrt", po), dir, bo);
 }
 
@@ -250,6 +254,81 @@ AttributeEnd
 
 INSTANTIATE_TEST_SUITE_P(All, PbrtFloor, ::testing::Values(integrator_kind::mixture, integrator_kind::nee, integrator_kind::mis),
                          integrator_name);
+
+// Every triangle strategy (--light-sampling) under every integrator, on the
+// floor under the nested triangle (one-sided) and under its two-sided
+// variant lit from the back: the same closed form (Lambert's), and the
+// lights built with the strategy asked for.
+using TriangleStrategyCase = std::tuple<light_sampling, integrator_kind>;
+class PbrtTriangleStrategies : public ::testing::TestWithParam<TriangleStrategyCase> {};
+
+TEST_P(PbrtTriangleStrategies, MatchLambertOneAndTwoSided) {
+  const auto [st, ik] = GetParam();
+  std::string two = floor_scene(with(nested_triangle, "\"bool twosided\" true"));
+  two.erase(two.find("ReverseOrientation"), std::string("ReverseOrientation").size());
+  int id = 300;
+  for (const std::string& text : {floor_scene(with(nested_triangle, "")), two}) {
+    const pbrt::built_scene b = from_text(text, "", st);
+    for (const light& l : b.world.lights) EXPECT_EQ(strategy_of(l), st);
+    const std::vector<glm::dvec3> poly = light_triangles(b.world).at(0);
+    for (const auto& [x, z] : floor_points)
+      check(floor_radiance(b.world, ik, x, z, id++), polygon_floor(poly, x, z), std::string(to_string(st)));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(All, PbrtTriangleStrategies,
+                         ::testing::Combine(::testing::Values(light_sampling::area, light_sampling::solid_angle,
+                                                              light_sampling::projected_solid_angle,
+                                                              light_sampling::bilinear_solid_angle, light_sampling::pbrt),
+                                            ::testing::Values(integrator_kind::mixture, integrator_kind::nee,
+                                                              integrator_kind::mis)),
+                         [](const ::testing::TestParamInfo<TriangleStrategyCase>& info) {
+                           std::string n = std::string(to_string(std::get<0>(info.param))) + "_" +
+                                           std::string(to_string(std::get<1>(info.param)));
+                           for (char& c : n)
+                             if (c == '-') c = '_';
+                           return n;
+                         });
+
+// pbrt-v4's triangle sampling takes area sampling below 3e-4 sr: a
+// triangle 1/50 the size of the nested one (about 1e-4 sr from the floor)
+// takes that branch at every floor point, the nested one the pre-warped
+// spherical triangle, and both match Lambert's formula.
+TEST(PbrtTriangleStrategies, PbrtsAreaBranchBelowItsThreshold) {
+  std::string small = floor_scene(with(nested_triangle, ""));
+  small.replace(small.find("Translate 0 1 0"), std::string("Translate 0 1 0").size(), "Translate 0 1 0\n    Scale 0.02 0.02 0.02");
+  for (const bool tiny : {true, false}) {
+    const pbrt::built_scene b = from_text(tiny ? small : floor_scene(with(nested_triangle, "")), "", light_sampling::pbrt);
+    ASSERT_EQ(b.world.lights.size(), 1u);
+    const auto& l = std::get<triangle_pbrt_sampler>(b.world.lights[0]);
+    const std::vector<glm::dvec3> poly = light_triangles(b.world).at(0);
+    int id = 400 + 10 * tiny;
+    for (const auto& [x, z] : floor_points) {
+      const vec3 o(x, 0.0f, z);
+      EXPECT_EQ(l.by_area(o), tiny) << x << " " << z;
+      check(floor_radiance(b.world, integrator_kind::nee, x, z, id++), polygon_floor(poly, x, z),
+            tiny ? "pbrt, area branch" : "pbrt, pre-warped branch");
+    }
+  }
+}
+
+// The vanishing variance (nee, direct light only, an unoccluded floor under
+// a triangle of constant radiance): projected-solid-angle sampling's
+// estimate is Omega_proj L rho / pi for every sample, so its standard error
+// is at most 1/10 of solid-angle sampling's at equal sample counts (it is
+// rounding only).
+TEST(PbrtTriangleStrategies, ProjectedSolidAngleHasAlmostNoVariance) {
+  const std::string text = floor_scene(with(nested_triangle, ""));
+  const pbrt::built_scene sa = from_text(text, "", light_sampling::solid_angle);
+  const pbrt::built_scene psa = from_text(text, "", light_sampling::projected_solid_angle);
+  int id = 500;
+  for (const auto& [x, z] : floor_points) {
+    const test::estimate a = floor_radiance(sa.world, integrator_kind::nee, x, z, id);
+    const test::estimate p = floor_radiance(psa.world, integrator_kind::nee, x, z, id++);
+    EXPECT_GT(a.stderr_, 0.0);
+    EXPECT_LE(p.stderr_, 0.1 * a.stderr_) << x << " " << z << ": psa " << p.stderr_ << " sa " << a.stderr_;
+  }
+}
 
 // A textured floor: an 8-bit image (2 x 2 texels, sRGB-encoded, in a PPM
 // file) as the reflectance, looked up bilinearly with v flipped (pbrt-v4's

@@ -659,10 +659,7 @@ class builder {
   light_sampling strategy_for(const std::string& shape, const file_loc& loc, light_sampling def) const {
     if (!opt_.strategy) return def;
     if (*opt_.strategy == light_sampling::automatic)
-      refuse(loc, "--light-sampling auto: not available for pbrt-v4 scenes");
-    if (shape == "triangle" && *opt_.strategy != light_sampling::area)
-      refuse(loc, "--light-sampling " + std::string(to_string(*opt_.strategy)) +
-                      ": triangle lights are sampled by area only");
+      refuse(loc, "--light-sampling auto: not available for pbrt-v4 scenes (a " + shape + " light)");
     return *opt_.strategy;
   }
 
@@ -755,20 +752,25 @@ class builder {
     auto mesh = std::make_shared<const triangle_mesh>(std::move(m));
     bool emits = false;
     const std::uint32_t mat = shape_material(emits);
-    if (emits) strategy_for("triangle", p.loc(), light_sampling::area);
+    const light_sampling st = emits ? strategy_for("triangle", p.loc(), light_sampling::area) : light_sampling::area;
     for (const triangle& tri : triangles_of(mesh)) {
       if (tri.area() == 0.0f) continue;  // a degenerate triangle is never hit
       out_.world.add(tri, mat);
-      if (emits) {
-        const triangle_area_sampler front(tri);
-        add_emitter([&](std::uint32_t mm) { add_light_only(front, mm); },
-                    [&](std::uint32_t mm) {
-                      triangle_area_sampler back = front;
-                      back.n = -back.n;
-                      add_light_only(back, mm);
-                    },
+      if (emits)
+        add_emitter([&](std::uint32_t mm) { add_light_only(triangle_light(tri, st, false), mm); },
+                    [&](std::uint32_t mm) { add_light_only(triangle_light(tri, st, true), mm); },
                     state_.light->twosided, mat);
-      }
+    }
+  }
+
+  // A triangle light's strategy (back: its back side's, for a two-sided light).
+  static light triangle_light(const triangle& t, light_sampling st, bool back) {
+    switch (st) {
+      case light_sampling::solid_angle: return triangle_solid_angle_sampler{t, back};
+      case light_sampling::projected_solid_angle: return triangle_projected_solid_angle_sampler{t, back};
+      case light_sampling::bilinear_solid_angle: return triangle_bilinear_solid_angle_sampler{t, back};
+      case light_sampling::pbrt: return triangle_pbrt_sampler{t, back};
+      default: return triangle_area_sampler{t, back};
     }
   }
 

@@ -12,30 +12,37 @@
 #include "mcrt/sampling/auto_strategy.hpp"
 #include "mcrt/sampling/bilinear_spherical_ellipse.hpp"
 #include "mcrt/sampling/bilinear_spherical_rectangle.hpp"
+#include "mcrt/sampling/bilinear_spherical_triangle.hpp"
 #include "mcrt/sampling/ellipse_area.hpp"
+#include "mcrt/sampling/pbrt_strategy.hpp"
 #include "mcrt/sampling/projected_rectangle.hpp"
 #include "mcrt/sampling/projected_spherical_cap.hpp"
 #include "mcrt/sampling/projected_spherical_ellipse.hpp"
+#include "mcrt/sampling/projected_triangle.hpp"
 #include "mcrt/sampling/rect_area.hpp"
 #include "mcrt/sampling/sphere_area.hpp"
 #include "mcrt/sampling/sphere_cone.hpp"
 #include "mcrt/sampling/spherical_ellipse.hpp"
 #include "mcrt/sampling/spherical_ellipse_polar.hpp"
 #include "mcrt/sampling/spherical_rectangle.hpp"
+#include "mcrt/sampling/spherical_triangle.hpp"
 #include "mcrt/sampling/triangle_area.hpp"
 
 namespace mcrt {
 
 // Every shape x strategy the renderer has. The dispatch (core/dispatch.hpp)
 // tests the alternatives in this order, so the strategies of the thesis's
-// scenes come first and the cosine-aware ones after them: a scene
-// that does not use a strategy pays for it at most one predictable compare.
+// scenes come first, the cosine-aware ones after them, then the triangles'
+// and pbrt-v4's: a scene that does not use a strategy pays for it at most
+// one predictable compare.
 using light = std::variant<rect_area_sampler, rect_solid_angle_sampler, ellipse_area_sampler,
                            ellipse_solid_angle_sampler, ellipse_polar_solid_angle_sampler, sphere_cone_sampler,
                            rect_projected_solid_angle_sampler, sphere_projected_solid_angle_sampler,
                            ellipse_projected_solid_angle_sampler, sphere_area_sampler,
                            rect_bilinear_solid_angle_sampler, ellipse_bilinear_solid_angle_sampler,
-                           rect_auto_sampler, ellipse_auto_sampler, sphere_auto_sampler, triangle_area_sampler>;
+                           rect_auto_sampler, ellipse_auto_sampler, sphere_auto_sampler, triangle_area_sampler,
+                           triangle_solid_angle_sampler, triangle_projected_solid_angle_sampler,
+                           triangle_bilinear_solid_angle_sampler, triangle_pbrt_sampler, rect_pbrt_sampler>;
 
 // The strategy a light-sampling class implements (--stats, mcrt samples).
 template <class S>
@@ -45,11 +52,15 @@ constexpr light_sampling strategy_of() {
     return light_sampling::area;
   else if constexpr (std::is_same_v<S, rect_projected_solid_angle_sampler> ||
                      std::is_same_v<S, sphere_projected_solid_angle_sampler> ||
-                     std::is_same_v<S, ellipse_projected_solid_angle_sampler>)
+                     std::is_same_v<S, ellipse_projected_solid_angle_sampler> ||
+                     std::is_same_v<S, triangle_projected_solid_angle_sampler>)
     return light_sampling::projected_solid_angle;
   else if constexpr (std::is_same_v<S, rect_bilinear_solid_angle_sampler> ||
-                     std::is_same_v<S, ellipse_bilinear_solid_angle_sampler>)
+                     std::is_same_v<S, ellipse_bilinear_solid_angle_sampler> ||
+                     std::is_same_v<S, triangle_bilinear_solid_angle_sampler>)
     return light_sampling::bilinear_solid_angle;
+  else if constexpr (std::is_same_v<S, triangle_pbrt_sampler> || std::is_same_v<S, rect_pbrt_sampler>)
+    return light_sampling::pbrt;
   else if constexpr (std::is_same_v<S, rect_auto_sampler> || std::is_same_v<S, ellipse_auto_sampler> ||
                      std::is_same_v<S, sphere_auto_sampler>)
     return light_sampling::automatic;

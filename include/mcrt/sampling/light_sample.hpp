@@ -48,10 +48,12 @@ struct light_sample {
 //   bilinear_solid_angle  the solid-angle map pre-warped by a bilinear
 //                         approximation of cos theta on its unit square
 //                         (Hart et al. 2020, as pbrt-v4), a comparison
-//                         strategy for rectangles and ellipses.
+//                         strategy for rectangles, ellipses and triangles;
+//   pbrt                  what pbrt-v4 ships for each shape, thresholds
+//                         included (pbrt_strategy.hpp).
 // automatic: `auto`, one of the first three chosen per light and shading
 // point (auto_strategy.hpp).
-enum class light_sampling { area, solid_angle, projected_solid_angle, bilinear_solid_angle, automatic };
+enum class light_sampling { area, solid_angle, projected_solid_angle, bilinear_solid_angle, automatic, pbrt };
 
 // The command line's and the scene format's name of a strategy.
 constexpr std::string_view to_string(light_sampling s) {
@@ -61,6 +63,7 @@ constexpr std::string_view to_string(light_sampling s) {
     case light_sampling::projected_solid_angle: return "projected-solid-angle";
     case light_sampling::bilinear_solid_angle: return "bilinear-solid-angle";
     case light_sampling::automatic: return "auto";
+    case light_sampling::pbrt: return "pbrt";
   }
   return "?";
 }

@@ -81,7 +81,9 @@ struct triangle_frame {
   bool valid = false;             // false for degenerate (zero-area or non-finite) triangles
 };
 
-inline triangle_frame make_triangle_frame(const triangle& t) {
+// back: the frame of the triangle's back side (a two-sided light's second
+// one-sided light).
+inline triangle_frame make_triangle_frame(const triangle& t, bool back = false) {
   triangle_frame f;
   dvec3 p[3] = {dvec3(t.vertex(0)), dvec3(t.vertex(1)), dvec3(t.vertex(2))};
   dvec3 c = glm::cross(p[1] - p[0], p[2] - p[0]);
@@ -89,7 +91,7 @@ inline triangle_frame make_triangle_frame(const triangle& t) {
   if (!(cl > 0.0) || !std::isfinite(cl)) return f;  // zero area or non-finite vertices
   // The front side is triangle::normal()'s; wind the vertices
   // counter-clockwise seen from it.
-  if (glm::dot(c, dvec3(t.normal())) < 0.0) {
+  if (glm::dot(c, dvec3(back ? -t.normal() : t.normal())) < 0.0) {
     std::swap(p[1], p[2]);
     c = -c;
   }
@@ -323,8 +325,10 @@ class projected_triangle : public projected_light_polygon<projected_triangle> {
 struct triangle_projected_solid_angle_sampler {
   triangle shape;  // fixed after construction (the frame below is derived from it)
 
-  explicit triangle_projected_solid_angle_sampler(const triangle& t)
-      : shape(t), frame_(projected_triangle_detail::make_triangle_frame(t)) {}
+  // back: sample the triangle's back side instead (the other half of a
+  // two-sided light).
+  explicit triangle_projected_solid_angle_sampler(const triangle& t, bool back = false)
+      : shape(t), frame_(projected_triangle_detail::make_triangle_frame(t, back)) {}
 
   bool faces(const vec3& o) const {
     return frame_.valid && glm::dot(dvec3(o) - frame_.p0, frame_.ez) > 0.0;

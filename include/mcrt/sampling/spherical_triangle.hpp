@@ -479,8 +479,10 @@ struct triangle_solid_angle_sampler {
   // Fixed after construction: the vertices and the front normal.
   vec3 p0{0.0f}, p1{0.0f}, p2{0.0f}, n{0.0f, 0.0f, 1.0f};
 
-  explicit triangle_solid_angle_sampler(const triangle& t)
-      : shape(t), p0(t.vertex(0)), p1(t.vertex(1)), p2(t.vertex(2)), n(t.normal()) {
+  // back: sample the triangle's back side instead (the other half of a
+  // two-sided light).
+  explicit triangle_solid_angle_sampler(const triangle& t, bool back = false)
+      : shape(t), p0(t.vertex(0)), p1(t.vertex(1)), p2(t.vertex(2)), n(back ? -t.normal() : t.normal()) {
     const dvec3 w = glm::cross(dvec3(p1) - dvec3(p0), dvec3(p2) - dvec3(p0));
     front_sign_ = glm::dot(w, dvec3(n)) < 0.0 ? 1.0 : -1.0;
   }

@@ -34,8 +34,10 @@ struct triangle_area_sampler {
   vec3 p0{0.0f}, p1{0.0f}, p2{0.0f}, n{0.0f, 0.0f, 1.0f};
   float area = 0.0f;
 
-  explicit triangle_area_sampler(const triangle& t)
-      : shape(t), p0(t.vertex(0)), p1(t.vertex(1)), p2(t.vertex(2)), n(t.normal()), area(t.area()) {}
+  // back: sample the triangle's back side instead (the other half of a
+  // two-sided light).
+  explicit triangle_area_sampler(const triangle& t, bool back = false)
+      : shape(t), p0(t.vertex(0)), p1(t.vertex(1)), p2(t.vertex(2)), n(back ? -t.normal() : t.normal()), area(t.area()) {}
 
   bool faces(const vec3& o) const { return glm::dot(o - p0, n) > 0.0f; }
 
