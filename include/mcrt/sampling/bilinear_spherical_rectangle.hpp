@@ -62,6 +62,7 @@
 #include <array>
 #include <cfloat>
 #include <cmath>
+#include <utility>
 
 #include "mcrt/geometry/rect.hpp"
 #include "mcrt/sampling/light_sample.hpp"
@@ -96,26 +97,26 @@ inline dvec2 bilinear_to_square(dvec2 p, const corner_weights& w) {
 
 }  // namespace bilinear_rect_detail
 
-// Light-sampling strategy: the spherical rectangle (rect_solid_angle_sampler)
-// behind the bilinear cosine pre-warp of [H20]. One-sided like the
-// spherical rectangle; no sample and pdf 0 where the direction or the whole
-// light lies below the receiver's horizon.
-struct rect_bilinear_solid_angle_sampler {
-  rect shape;  // fixed after construction (sa_ is built from it)
-
+// What the pre-warped strategies share (this rectangle's, the triangle's of
+// bilinear_spherical_triangle.hpp): the bilinear warp of u before the
+// solid-angle map, its density at the warped point, and the same through the
+// map's inverse for pdf() and invert(). Derived supplies weights(o, n, w)
+// (false where the whole light is at or below the horizon) and
+// map_inverse(o, dir, u') (the unit-square point of the solid-angle map
+// whose direction is dir; false where there is none).
+template <class Derived, class SolidAngle>
+struct bilinear_prewarp {
   // Least corner weight (see the header): pbrt-v4's 0.01.
   static constexpr double weight_floor = 0.01;
-
-  explicit rect_bilinear_solid_angle_sampler(const rect& r) : shape(r), sa_(r) {}
 
   bool faces(const vec3& o) const { return sa_.faces(o); }
 
   bool sample(const vec3& o, const vec3& n, vec2 u, light_sample& s) const {
     using namespace bilinear_rect_detail;
     corner_weights w;
-    if (!weights(o, n, w)) return false;
-    // The warped point as the float the spherical rectangle receives, and
-    // the bilinear density at that very point.
+    if (!self().weights(o, n, w)) return false;
+    // The warped point as the float the solid-angle map receives, and the
+    // bilinear density at that very point.
     const vec2 up(square_to_bilinear(dvec2(u), w));
     light_sample t;
     if (!sa_.sample(o, up, t)) return false;
@@ -128,15 +129,15 @@ struct rect_bilinear_solid_angle_sampler {
   }
 
   // Density per unit SOLID ANGLE at o of the unit direction dir for the
-  // receiver's normal n: p_rect(dir) * p_bilinear(map^-1(dir)); 0 below the
+  // receiver's normal n: p_map(dir) * p_bilinear(map^-1(dir)); 0 below the
   // horizon, behind the light, or if the ray misses. The cheap tests come
   // first: a direction that misses costs no set-up.
   float pdf(const vec3& o, const vec3& n, const vec3& dir) const {
     dvec2 up;
-    double p_rect;
+    double p_map;
     bilinear_rect_detail::corner_weights w;
-    if (!preimage(o, n, dir, up, p_rect, w)) return 0.0f;
-    const double p = p_rect * bilinear_rect_detail::square_to_bilinear_pdf(up, w);
+    if (!preimage(o, n, dir, up, p_map, w)) return 0.0f;
+    const double p = p_map * bilinear_rect_detail::square_to_bilinear_pdf(up, w);
     return p <= double(FLT_MAX) ? float(p) : 0.0f;
   }
 
@@ -144,12 +145,41 @@ struct rect_bilinear_solid_angle_sampler {
   // (u untouched) where pdf() is 0.
   bool invert(const vec3& o, const vec3& n, const vec3& dir, vec2& u) const {
     dvec2 up;
-    double p_rect;
+    double p_map;
     bilinear_rect_detail::corner_weights w;
-    if (!preimage(o, n, dir, up, p_rect, w)) return false;
+    if (!preimage(o, n, dir, up, p_map, w)) return false;
     u = vec2(bilinear_rect_detail::bilinear_to_square(up, w));
     return true;
   }
+
+ protected:
+  explicit bilinear_prewarp(SolidAngle sa) : sa_(std::move(sa)) {}
+  const Derived& self() const { return static_cast<const Derived&>(*this); }
+
+  // dir -> (u', the map's density, weights); false where the density is 0.
+  bool preimage(const vec3& o, const vec3& n, const vec3& dir, dvec2& up, double& p_map,
+                bilinear_rect_detail::corner_weights& w) const {
+    if (!(glm::dot(dvec3(dir), dvec3(n)) > 0.0)) return false;
+    const float ps = sa_.pdf(o, dir);  // ray test first, 0 behind the light
+    if (!(ps > 0.0f)) return false;
+    if (!self().weights(o, n, w)) return false;
+    if (!self().map_inverse(o, dir, up)) return false;
+    p_map = double(ps);
+    return true;
+  }
+
+  SolidAngle sa_;
+};
+
+// Light-sampling strategy: the spherical rectangle (rect_solid_angle_sampler)
+// behind the bilinear cosine pre-warp of [H20]. One-sided like the
+// spherical rectangle; no sample and pdf 0 where the direction or the whole
+// light lies below the receiver's horizon.
+struct rect_bilinear_solid_angle_sampler
+    : bilinear_prewarp<rect_bilinear_solid_angle_sampler, rect_solid_angle_sampler> {
+  rect shape;  // fixed after construction (sa_ is built from it)
+
+  explicit rect_bilinear_solid_angle_sampler(const rect& r) : bilinear_prewarp(rect_solid_angle_sampler(r)), shape(r) {}
 
   // The corner weights for the receiver (o, n); false where the whole light
   // is at or below the horizon (or n is not a direction).
@@ -166,23 +196,14 @@ struct rect_bilinear_solid_angle_sampler {
     return above && nl > 0.0 && std::isfinite(nl);
   }
 
- private:
-  // dir -> (u', p_rect, weights); false where the density is 0.
-  bool preimage(const vec3& o, const vec3& n, const vec3& dir, dvec2& up, double& p_rect,
-                bilinear_rect_detail::corner_weights& w) const {
-    if (!(glm::dot(dvec3(dir), dvec3(n)) > 0.0)) return false;
-    const float ps = sa_.pdf(o, dir);  // ray test first, 0 behind the light
-    if (!(ps > 0.0f)) return false;
-    if (!weights(o, n, w)) return false;
+  // The spherical rectangle's unit-square point of dir (its exact map).
+  bool map_inverse(const vec3& o, const vec3& dir, dvec2& up) const {
     const spherical_rectangle sr(shape, o);
     double t;
     if (!sr.intersect(dvec3(dir), t)) return false;
     up = sr.invert_offset(t * dvec3(dir));
-    p_rect = double(ps);
     return true;
   }
-
-  rect_solid_angle_sampler sa_;
 };
 
 }  // namespace mcrt

@@ -52,60 +52,17 @@
 namespace mcrt {
 
 // Light-sampling strategy: the spherical triangle (triangle_solid_angle_
-// sampler) behind the bilinear cosine pre-warp of Hart et al. 2020. One-sided
-// like the spherical triangle (back: the sampler of the triangle's back
-// side, for two-sided lights); no sample and pdf 0 where the direction or
-// the whole light lies below the receiver's horizon.
-struct triangle_bilinear_solid_angle_sampler {
+// sampler) behind the bilinear cosine pre-warp of Hart et al. 2020
+// (bilinear_prewarp, shared with the rectangle's). One-sided like the
+// spherical triangle (back: the sampler of the triangle's back side, for
+// two-sided lights); no sample and pdf 0 where the direction or the whole
+// light lies below the receiver's horizon.
+struct triangle_bilinear_solid_angle_sampler
+    : bilinear_prewarp<triangle_bilinear_solid_angle_sampler, triangle_solid_angle_sampler> {
   triangle shape;  // fixed after construction (sa_ is built from it)
 
-  // Least corner weight (see the header): pbrt-v4's 0.01.
-  static constexpr double weight_floor = 0.01;
-
-  explicit triangle_bilinear_solid_angle_sampler(const triangle& t, bool back = false) : shape(t), sa_(t, back) {}
-
-  bool faces(const vec3& o) const { return sa_.faces(o); }
-
-  bool sample(const vec3& o, const vec3& n, vec2 u, light_sample& s) const {
-    using namespace bilinear_rect_detail;
-    corner_weights w;
-    if (!weights(o, n, w)) return false;
-    // The warped point as the float the spherical triangle receives, and the
-    // bilinear density at that very point.
-    const vec2 up(square_to_bilinear(dvec2(u), w));
-    light_sample t;
-    if (!sa_.sample(o, up, t)) return false;
-    if (!(glm::dot(dvec3(t.dir), dvec3(n)) > 0.0)) return false;  // below the horizon
-    const double p = double(t.pdf) * square_to_bilinear_pdf(dvec2(up), w);
-    if (!(p > 0.0) || !(p <= double(FLT_MAX))) return false;
-    s = t;
-    s.pdf = float(p);
-    return true;
-  }
-
-  // Density per unit SOLID ANGLE at o of the unit direction dir for the
-  // receiver's normal n: p_bilinear(map^-1(dir)) / Omega; 0 below the
-  // horizon, behind the light, or where the ray misses. The spherical
-  // triangle's pdf comes first: a direction that misses costs no set-up.
-  float pdf(const vec3& o, const vec3& n, const vec3& dir) const {
-    dvec2 up;
-    double p_sa;
-    bilinear_rect_detail::corner_weights w;
-    if (!preimage(o, n, dir, up, p_sa, w)) return 0.0f;
-    const double p = p_sa * bilinear_rect_detail::square_to_bilinear_pdf(up, w);
-    return p <= double(FLT_MAX) ? float(p) : 0.0f;
-  }
-
-  // Unit direction dir -> the unit-square point sample() maps onto it; false
-  // (u untouched) where pdf() is 0.
-  bool invert(const vec3& o, const vec3& n, const vec3& dir, vec2& u) const {
-    dvec2 up;
-    double p_sa;
-    bilinear_rect_detail::corner_weights w;
-    if (!preimage(o, n, dir, up, p_sa, w)) return false;
-    u = vec2(bilinear_rect_detail::bilinear_to_square(up, w));
-    return true;
-  }
+  explicit triangle_bilinear_solid_angle_sampler(const triangle& t, bool back = false)
+      : bilinear_prewarp(triangle_solid_angle_sampler(t, back)), shape(t) {}
 
   // The corner weights for the receiver (o, n), in pbrt-v4's order (p1, p1,
   // p0, p2); false where the whole light is at or below the horizon (or n
@@ -126,21 +83,12 @@ struct triangle_bilinear_solid_angle_sampler {
     return above;
   }
 
- private:
-  // dir -> (u', 1 / Omega, weights); false where the density is 0.
-  bool preimage(const vec3& o, const vec3& n, const vec3& dir, dvec2& up, double& p_sa,
-                bilinear_rect_detail::corner_weights& w) const {
-    if (!(glm::dot(dvec3(dir), dvec3(n)) > 0.0)) return false;
-    const float ps = sa_.pdf(o, dir);  // ray test first, 0 behind the light
-    if (!(ps > 0.0f)) return false;
-    if (!weights(o, n, w)) return false;
+  // Arvo's unit-square point of dir (spherical_triangle::invert_offset).
+  bool map_inverse(const vec3& o, const vec3& dir, dvec2& up) const {
     const spherical_triangle st(dvec3(o), dvec3(sa_.p0), dvec3(sa_.p1), dvec3(sa_.p2));
     up = st.invert_offset(dvec3(dir));
-    p_sa = double(ps);
     return true;
   }
-
-  triangle_solid_angle_sampler sa_;
 };
 
 }  // namespace mcrt

@@ -24,6 +24,8 @@
 // double, triangle_solid_angle; pbrt-v4
 // evaluates the same quantity in float): the branch taken can differ from
 // pbrt-v4's only within its float rounding of the threshold.
+#include <utility>
+
 #include "mcrt/geometry/rect.hpp"
 #include "mcrt/geometry/triangle_mesh.hpp"
 #include "mcrt/sampling/bilinear_spherical_rectangle.hpp"
@@ -35,52 +37,61 @@
 
 namespace mcrt {
 
-// pbrt-v4's triangle light sampling (the header's first item). One-sided
-// (back: the back side of a two-sided light), like both of its strategies.
-struct triangle_pbrt_sampler {
-  triangle shape;
-  // pbrt-v4's Triangle::MinSphericalSampleArea and MaxSphericalSampleArea (sr).
-  static constexpr double min_solid_angle = 3e-4, max_solid_angle = 6.22;
-
-  explicit triangle_pbrt_sampler(const triangle& t, bool back = false) : shape(t), area_(t, back), warped_(t, back) {}
-
+// What both composites share: area sampling where the shape's by_area(o)
+// says so, the pre-warped map elsewhere, both one-sided.
+template <class Derived, class Area, class Warped>
+struct pbrt_choice {
   bool faces(const vec3& o) const { return warped_.faces(o); }
-
-  // Whether pbrt-v4 samples the triangle by area from o.
-  bool by_area(const vec3& o) const {
-    const double omega = triangle_solid_angle(dvec3(o), dvec3(shape.vertex(0)),
-                                                                          dvec3(shape.vertex(1)), dvec3(shape.vertex(2)));
-    return omega < min_solid_angle || omega > max_solid_angle;
-  }
 
   bool sample(const vec3& o, const vec3& n, vec2 u, light_sample& s) const {
     if (!faces(o)) return false;
-    return by_area(o) ? area_.sample(o, u, s) : warped_.sample(o, n, u, s);
+    return self().by_area(o) ? area_.sample(o, u, s) : warped_.sample(o, n, u, s);
   }
 
   // Density per unit SOLID ANGLE at o of the unit direction dir for the
   // receiver's normal n: the area density converted to solid angle, or the
-  // pre-warped spherical triangle's, by the threshold at o.
+  // pre-warped map's, by the threshold at o as sample() decides it.
   float pdf(const vec3& o, const vec3& n, const vec3& dir) const {
     if (!faces(o)) return 0.0f;
-    return by_area(o) ? area_.pdf(o, dir) : warped_.pdf(o, n, dir);
+    return self().by_area(o) ? area_.pdf(o, dir) : warped_.pdf(o, n, dir);
   }
 
- private:
-  triangle_area_sampler area_;
-  triangle_bilinear_solid_angle_sampler warped_;
+ protected:
+  pbrt_choice(Area area, Warped warped) : area_(std::move(area)), warped_(std::move(warped)) {}
+  const Derived& self() const { return static_cast<const Derived&>(*this); }
+
+  Area area_;
+  Warped warped_;
+};
+
+// pbrt-v4's triangle light sampling (the header's first item). One-sided
+// (back: the back side of a two-sided light), like both of its strategies.
+struct triangle_pbrt_sampler
+    : pbrt_choice<triangle_pbrt_sampler, triangle_area_sampler, triangle_bilinear_solid_angle_sampler> {
+  triangle shape;
+  // pbrt-v4's Triangle::MinSphericalSampleArea and MaxSphericalSampleArea (sr).
+  static constexpr double min_solid_angle = 3e-4, max_solid_angle = 6.22;
+
+  explicit triangle_pbrt_sampler(const triangle& t, bool back = false)
+      : pbrt_choice(triangle_area_sampler(t, back), triangle_bilinear_solid_angle_sampler(t, back)), shape(t) {}
+
+  // Whether pbrt-v4 samples the triangle by area from o.
+  bool by_area(const vec3& o) const {
+    const double omega =
+        triangle_solid_angle(dvec3(o), dvec3(shape.vertex(0)), dvec3(shape.vertex(1)), dvec3(shape.vertex(2)));
+    return omega < min_solid_angle || omega > max_solid_angle;
+  }
 };
 
 // pbrt-v4's rectangle light sampling (the header's second item). One-sided.
-struct rect_pbrt_sampler {
+struct rect_pbrt_sampler : pbrt_choice<rect_pbrt_sampler, rect_area_sampler, rect_bilinear_solid_angle_sampler> {
   rect shape;
   // pbrt-v4's BilinearPatch::MinSphericalSampleArea (sr): area sampling at
   // or below it.
   static constexpr double min_solid_angle = 1e-4;
 
-  explicit rect_pbrt_sampler(const rect& r) : shape(r), area_(r), warped_(r) {}
-
-  bool faces(const vec3& o) const { return warped_.faces(o); }
+  explicit rect_pbrt_sampler(const rect& r)
+      : pbrt_choice(rect_area_sampler(r), rect_bilinear_solid_angle_sampler(r)), shape(r) {}
 
   // Whether pbrt-v4 samples the rectangle by area from o: its solid angle
   // as the two triangles (corner, +e1, +e1+e2) and (corner, +e1+e2, +e2).
@@ -90,22 +101,6 @@ struct rect_pbrt_sampler {
                          triangle_solid_angle(od, c, c + e1 + e2, c + e2);
     return omega <= min_solid_angle;
   }
-
-  bool sample(const vec3& o, const vec3& n, vec2 u, light_sample& s) const {
-    if (!faces(o)) return false;
-    return by_area(o) ? area_.sample(o, u, s) : warped_.sample(o, n, u, s);
-  }
-
-  // Density per unit SOLID ANGLE at o of the unit direction dir for the
-  // receiver's normal n, by the threshold at o as sample() decides it.
-  float pdf(const vec3& o, const vec3& n, const vec3& dir) const {
-    if (!faces(o)) return 0.0f;
-    return by_area(o) ? area_.pdf(o, dir) : warped_.pdf(o, n, dir);
-  }
-
- private:
-  rect_area_sampler area_;
-  rect_bilinear_solid_angle_sampler warped_;
 };
 
 }  // namespace mcrt
