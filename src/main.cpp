@@ -129,7 +129,10 @@ int run_render(const render_options& opt) {
   rs.filter = ls.filter == "gaussian" ? pixel_filter::gaussian(ls.filter_radius, ls.filter_sigma)
               : ls.filter == "triangle" ? pixel_filter::triangle(ls.filter_radius)
                                         : pixel_filter::box(ls.filter_radius);
-  rs.choose = light_select == "uniform" ? light_choice::uniform : light_choice::power;
+  rs.choose = light_select == "uniform"    ? light_choice::uniform
+              : light_select == "bvh"      ? light_choice::bvh
+              : light_select == "pbrt-bvh" ? light_choice::pbrt_bvh
+                                           : light_choice::power;
 
   std::optional<noise_pilot_result> noise;
   double edge_factor = 1.0;  // kappa_E (render/noise_pilot.hpp)
@@ -308,9 +311,10 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--mis-heuristic", ro.mis_heuristic, "Weights of --integrator mis: power (beta = 2, default) or balance")
       ->check(CLI::IsMember({"power", "balance"}));
   render_cmd->add_option("--light-select", ro.light_select,
-                         "How nee and mis choose among several lights: power (by emitted flux; default, or the pbrt-v4 "
-                         "file's) or uniform")
-      ->check(CLI::IsMember({"power", "uniform"}));
+                         "How nee and mis choose among several lights: power (by emitted flux; the default of JSON "
+                         "scenes), uniform, bvh (a light hierarchy with mcrt's importance; pbrt-v4's default) or "
+                         "pbrt-bvh (pbrt-v4's BVHLightSampler as it ships); a pbrt-v4 file's lightsampler otherwise")
+      ->check(CLI::IsMember({"power", "uniform", "bvh", "pbrt-bvh"}));
   render_cmd->add_option("--stats", ro.stats, "Write render statistics as JSON to this file");
   render_cmd->add_flag("--quiet", ro.quiet, "No progress line");
 

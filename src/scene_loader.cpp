@@ -481,6 +481,7 @@ loaded_scene load_scene(const std::string& path, std::optional<light_sampling> o
   // Shirley's scenes keep their lists: their few shapes are large (the
   // Cornell boxes' boxes), which the hierarchy's boxes do not cull, and
   // they render 11-22 % slower through it (bench/ab_render.sh).
+  out.world.build_light_tree();
   out.make_camera = [c = out.cam](int, int) {
     return camera(c.lookfrom, c.lookat, c.vup, c.vfov, static_cast<float>(c.width) / static_cast<float>(c.height));
   };

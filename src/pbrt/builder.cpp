@@ -161,6 +161,7 @@ class builder {
     if (!stack_.empty()) refuse(ds.back().loc, "AttributeBegin without AttributeEnd");
     if (out_.world.object_count() == 0) refuse(ds.back().loc, "the scene has no shapes");
     out_.world.build_accelerator();
+    out_.world.build_light_tree();
     return std::move(out_);
   }
 
@@ -404,10 +405,8 @@ class builder {
       p.fail("maxdepth must be in [0, " + std::to_string(max_path_depth) + "]");
     if (p.boolean("regularize", false)) p.fail(*p.find("regularize"), "true is not supported");
     if (const auto ls = p.string("lightsampler")) {
-      if (*ls == "uniform")
-        out_.light_select = "uniform";
-      else if (*ls == "power" || *ls == "bvh")
-        out_.light_select = "power";  // bvh: nearest by power (noise differs, not the expected image)
+      if (*ls == "uniform" || *ls == "power" || *ls == "bvh")
+        out_.light_select = *ls;
       else
         p.fail(*p.find("lightsampler"), "must be uniform, power or bvh");
     }

@@ -47,10 +47,10 @@ struct built_scene {
   // Sampler: mcrt's sample generator and pbrt-v4's count of samples per pixel.
   std::string sampler = "sobol";  // pbrt-v4's default zsobol -> sobol
   int spp = 16;
-  // Integrator: maxdepth (pbrt-v4's default 5), and its light sampler
-  // mapped to mcrt's light selection ("power" or "uniform").
+  // Integrator: maxdepth (pbrt-v4's default 5), and its light sampler as
+  // mcrt's light selection ("power", "uniform" or "bvh", pbrt-v4's default).
   int max_depth = 5;
-  std::string light_select = "power";
+  std::string light_select = "bvh";
   // The lights in the order the file defines them (a mesh's in face order):
   // each one's entries in world.emitters, two for a two-sided light (its
   // front and its back, each sampled from its own side).

@@ -156,7 +156,9 @@ struct next_event_integrator {
         // side, from the point moved off the surface to the side the ray
         // came from: on an emitter's own surface, its plane's side decides
         // by more than rounding whether its own light faces the point.
-        const light_selection sel(sc, rec.spawn_origin(-r.d), wo.z < 0.0f ? -fr.z : fr.z, set.choose);
+        // A surface that transmits takes light from both sides of its horizon.
+        constexpr bool transmits = !std::is_same_v<std::decay_t<decltype(bsdf)>, conductor_bsdf>;
+        const light_selection sel(sc, rec.spawn_origin(-r.d), wo.z < 0.0f ? -fr.z : fr.z, set.choose, transmits);
         if (!bsdf.is_delta())
           radiance += throughput * sample_direct_light_bsdf<Weights>(sc, rec, fr, wo, bsdf, sel, ps, b, set);
         if (depth >= set.rr_depth && !survive_roulette(throughput, [&] { return ps.get1d(b + layout::roulette); })) {

@@ -104,6 +104,7 @@ struct ray_counting_scene {
   std::uint64_t& rays;
   const decltype(Scene::lights)& lights = inner.lights;
   const decltype(Scene::emitters)& emitters = inner.emitters;
+  const light_bvh& light_tree = inner.light_tree;
   const decltype(Scene::materials)& materials = inner.materials;
   const color& background = inner.background;
   const std::size_t& unsampled_emitters = inner.unsampled_emitters;

@@ -22,6 +22,7 @@
 #include "mcrt/geometry/triangle_mesh.hpp"
 #include "mcrt/materials/material.hpp"
 #include "mcrt/render/light.hpp"
+#include "mcrt/render/light_importance.hpp"
 
 namespace mcrt {
 
@@ -52,6 +53,9 @@ struct basic_scene {
   std::vector<light> lights;
   // The lights that emit, for the next-event estimators (nee, mis).
   std::vector<emitter> emitters;
+  // The hierarchy over the emitters (item i: emitters[i]) by which
+  // light_selection chooses among many (build_light_tree).
+  light_bvh light_tree;
   color background{0.0f};
   // Shapes added by add() (not add_light) whose material emits, or was not
   // yet known when they were added: light that only the material's samples
@@ -84,6 +88,7 @@ struct basic_scene {
   template <class Strategy>
   std::uint32_t add_light(const Strategy& strategy, std::uint32_t material_index) {
     add_geometry(strategy.shape, material_index);
+    light_tree = light_bvh();  // a tree over the lights before this one no longer holds them all
     const auto k = static_cast<std::uint32_t>(lights.size());
     lights.emplace_back(strategy);
     if (const auto* e = std::get_if<diffuse_light>(&materials.at(material_index)))
@@ -137,6 +142,16 @@ struct basic_scene {
     }
     accel_.renumber_in_order();
     accel_active_ = true;
+  }
+
+  // Builds the light hierarchy over the emitters (render/light_selection.hpp
+  // uses it for bvh, and for power and uniform past a few emitters). Lights
+  // added later are not in it until it is called again.
+  void build_light_tree() {
+    std::vector<light_bounds> items;
+    items.reserve(emitters.size());
+    for (const emitter& e : emitters) items.push_back(bounds_of(lights[e.light], e.power));
+    light_tree = light_bvh(items);
   }
 
   // Whether hit() traverses the hierarchy.

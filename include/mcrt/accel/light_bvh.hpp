@@ -1,0 +1,230 @@
+#pragma once
+// A bounding volume hierarchy over lights, for choosing one light among many
+// by its importance at a shading point (Conty Estevez & Kulla 2018,
+// "Importance Sampling of Many Lights with Adaptive Tree Splitting", sec. 4;
+// pbrt-v4's BVHLightSampler and LightBounds, src/pbrt/lightsamplers.h/.cpp,
+// "Physically Based Rendering", 4th ed., sec. 12.6.3).
+//
+// Every node bounds the lights below it by a box, a cone holding their
+// emitting normals (axis w, half-angle theta_o), the angle theta_e beyond a
+// normal to which they emit (pi/2 for a lambertian surface) and their total
+// flux phi. The tree is built top-down as pbrt-v4 builds it: at each node
+// the lights are split at the cheapest of 11 bucket boundaries per axis by
+// the cost phi M_Omega(theta_o, theta_e) K_r SA(box) of each side (Conty
+// Estevez & Kulla, eq. 2 to 4), down to one light per leaf. The lights of a
+// subtree are contiguous in order(), so a node also names the range of them.
+//
+// The hierarchy holds geometry only; what a node is worth at a point (the
+// importance) is the caller's (render/light_selection.hpp), so one tree
+// serves every way of choosing.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "mcrt/core/math.hpp"
+#include "mcrt/geometry/aabb.hpp"
+
+namespace mcrt {
+
+namespace light_bvh_detail {
+
+// sqrt of a value that rounding may have left slightly below 0 (1 - cos^2
+// of a unit dot product): 0 there instead of NaN (pbrt-v4's SafeSqrt).
+inline float safe_sqrt(float x) { return std::sqrt(std::max(x, 0.0f)); }
+// acos of a value rounding may have left slightly outside [-1, 1].
+inline float safe_acos(float x) { return std::acos(std::clamp(x, -1.0f, 1.0f)); }
+
+// Rotates v about the unit axis k by the angle theta (Rodrigues' formula).
+inline vec3 rotate(const vec3& v, const vec3& k, float theta) {
+  const float c = std::cos(theta), s = std::sin(theta);
+  return v * c + glm::cross(k, v) * s + k * (glm::dot(k, v) * (1.0f - c));
+}
+
+}  // namespace light_bvh_detail
+
+// A cone of directions about the unit axis w with half-angle acos(cos_theta):
+// cos_theta = -1 is every direction.
+struct direction_cone {
+  vec3 w{0.0f, 0.0f, 1.0f};
+  float cos_theta = 1.0f;
+
+  static direction_cone entire_sphere() { return {vec3(0.0f, 0.0f, 1.0f), -1.0f}; }
+};
+
+// The smallest cone holding both (pbrt-v4's Union(DirectionCone,
+// DirectionCone), vecmath.cpp; Conty Estevez & Kulla, Algorithm 1).
+inline direction_cone unite(const direction_cone& a, const direction_cone& b) {
+  using namespace light_bvh_detail;
+  const float theta_a = safe_acos(a.cos_theta), theta_b = safe_acos(b.cos_theta);
+  const float theta_d = safe_acos(glm::dot(a.w, b.w));
+  if (std::min(theta_d + theta_b, pi) <= theta_a) return a;
+  if (std::min(theta_d + theta_a, pi) <= theta_b) return b;
+  const float theta_o = 0.5f * (theta_a + theta_d + theta_b);
+  if (theta_o >= pi) return direction_cone::entire_sphere();
+  // a's axis turned towards b's by theta_o - theta_a.
+  const vec3 k = glm::cross(a.w, b.w);
+  const float k2 = glm::dot(k, k);
+  // Axes exactly opposite (or too close for a rotation axis): the whole sphere.
+  if (!(k2 > 0.0f)) return direction_cone::entire_sphere();
+  const vec3 w = glm::normalize(rotate(a.w, k / std::sqrt(k2), theta_o - theta_a));
+  // Widened by 1e-5 rad, over the float rounding of the rotation and the
+  // angles (measured up to 6e-7 rad), so that the cone holds both.
+  constexpr float guard = 1e-5f;
+  if (theta_o + guard >= pi) return direction_cone::entire_sphere();
+  return {w, std::cos(theta_o + guard)};
+}
+
+// What a node knows of its lights (pbrt-v4's LightBounds, one-sided: a
+// two-sided light is two lights here, one per side).
+struct light_bounds {
+  aabb box;
+  direction_cone normals;     // the emitting normals' cone (theta_o)
+  float cos_theta_e = 0.0f;   // cos of the emission's spread beyond a normal: pi/2 for a lambertian emitter
+  float phi = 0.0f;           // flux (here: pi * area * luminance of the radiance)
+};
+
+inline light_bounds unite(const light_bounds& a, const light_bounds& b) {
+  if (!(a.phi > 0.0f)) return b;
+  if (!(b.phi > 0.0f)) return a;
+  light_bounds u;
+  u.box = a.box;
+  u.box.grow(b.box);
+  u.normals = unite(a.normals, b.normals);
+  u.cos_theta_e = std::min(a.cos_theta_e, b.cos_theta_e);
+  u.phi = a.phi + b.phi;
+  return u;
+}
+
+class light_bvh {
+ public:
+  struct node {
+    light_bounds bounds;
+    std::uint32_t second = 0;       // an inner node's second child (the first is the next node)
+    std::uint32_t first = 0;        // its lights: order()[first, first + count)
+    std::uint32_t count = 0;
+    std::uint32_t parent = none;
+    bool leaf() const { return count == 1; }
+  };
+  static constexpr std::uint32_t none = 0xffffffffu;
+
+  light_bvh() = default;
+
+  // Builds the hierarchy over items (one per light; an item of zero flux is
+  // left out: it is never chosen).
+  explicit light_bvh(const std::vector<light_bounds>& items) {
+    leaf_of_.assign(items.size(), none);
+    std::vector<std::uint32_t> ids;
+    for (std::uint32_t i = 0; i < items.size(); ++i)
+      if (items[i].phi > 0.0f && !items[i].box.empty()) ids.push_back(i);
+    if (ids.empty()) return;
+    nodes_.reserve(2 * ids.size());
+    order_.reserve(ids.size());
+    build(items, ids, 0, static_cast<std::uint32_t>(ids.size()), none, 0);
+  }
+
+  // The depth no tree exceeds (the traversals' stacks): past max_depth - 24
+  // a range is halved instead of split by cost, so 2^24 lights fit.
+  static constexpr std::size_t max_depth = 96;
+
+  bool empty() const { return nodes_.empty(); }
+  const std::vector<node>& nodes() const { return nodes_; }
+  // The items in the leaves' order (a subtree's are contiguous).
+  const std::vector<std::uint32_t>& order() const { return order_; }
+  // The leaf holding item i, or none (an item left out).
+  std::uint32_t leaf_of(std::size_t i) const { return i < leaf_of_.size() ? leaf_of_[i] : none; }
+
+  // The surface-area-orientation cost of a cluster (Conty Estevez & Kulla,
+  // eq. 2 and 4; pbrt-v4's BVHLightSampler::EvaluateCost): flux times the
+  // measure M_Omega of the directions its normals' cone and emission spread
+  // reach, times the box's area, times K_r, which favours splits across a
+  // long box.
+  static float cost(const light_bounds& b, const aabb& parent_box, int dim) {
+    using namespace light_bvh_detail;
+    const float theta_o = safe_acos(b.normals.cos_theta), theta_e = safe_acos(b.cos_theta_e);
+    const float theta_w = std::min(theta_o + theta_e, pi);
+    const float sin_o = safe_sqrt(1.0f - b.normals.cos_theta * b.normals.cos_theta);
+    const float m_omega = 2.0f * pi * (1.0f - b.normals.cos_theta) +
+                          0.5f * pi * (2.0f * theta_w * sin_o - std::cos(theta_o - 2.0f * theta_w) -
+                                       2.0f * theta_o * sin_o + b.normals.cos_theta);
+    const vec3 d = parent_box.hi - parent_box.lo;
+    const float kr = std::max({d.x, d.y, d.z}) / d[dim];
+    return b.phi * m_omega * kr * b.box.surface_area();
+  }
+
+ private:
+  std::uint32_t build(const std::vector<light_bounds>& items, std::vector<std::uint32_t>& ids, std::uint32_t begin,
+                      std::uint32_t end, std::uint32_t parent, std::size_t depth) {
+    const auto index = static_cast<std::uint32_t>(nodes_.size());
+    nodes_.emplace_back();
+    nodes_[index].parent = parent;
+    if (end - begin == 1) {
+      const std::uint32_t item = ids[begin];
+      nodes_[index].bounds = items[item];
+      nodes_[index].first = static_cast<std::uint32_t>(order_.size());
+      nodes_[index].count = 1;
+      order_.push_back(item);
+      leaf_of_[item] = index;
+      return index;
+    }
+    light_bounds all;
+    aabb centroids;
+    for (std::uint32_t i = begin; i < end; ++i) {
+      all = unite(all, items[ids[i]]);
+      centroids.grow(items[ids[i]].box.centroid());
+    }
+    // The cheapest bucket boundary over the three axes (12 buckets each).
+    constexpr int buckets = 12;
+    float best_cost = std::numeric_limits<float>::infinity();
+    int best_dim = -1, best_split = -1;
+    const auto bucket_of = [&](std::uint32_t id, int dim) {
+      const float lo = centroids.lo[dim], hi = centroids.hi[dim];
+      const int b = static_cast<int>(buckets * ((items[id].box.centroid()[dim] - lo) / (hi - lo)));
+      return std::clamp(b, 0, buckets - 1);
+    };
+    for (int dim = 0; dim < 3 && depth + 24 < max_depth; ++dim) {
+      if (!(centroids.hi[dim] > centroids.lo[dim])) continue;
+      std::array<light_bounds, buckets> bk{};
+      for (std::uint32_t i = begin; i < end; ++i) bk[bucket_of(ids[i], dim)] = unite(bk[bucket_of(ids[i], dim)], items[ids[i]]);
+      for (int s = 0; s + 1 < buckets; ++s) {
+        light_bounds below, above;
+        for (int b = 0; b <= s; ++b) below = unite(below, bk[b]);
+        for (int b = s + 1; b < buckets; ++b) above = unite(above, bk[b]);
+        if (!(below.phi > 0.0f) || !(above.phi > 0.0f)) continue;
+        const float c = cost(below, all.box, dim) + cost(above, all.box, dim);
+        if (c > 0.0f && c < best_cost) {
+          best_cost = c;
+          best_dim = dim;
+          best_split = s;
+        }
+      }
+    }
+    std::uint32_t mid;
+    if (best_dim < 0) {
+      // Every centroid in one place (or no split with a finite cost): the
+      // range halved, as pbrt-v4 does.
+      mid = begin + (end - begin) / 2;
+    } else {
+      const auto it = std::partition(ids.begin() + begin, ids.begin() + end,
+                                     [&](std::uint32_t id) { return bucket_of(id, best_dim) <= best_split; });
+      mid = static_cast<std::uint32_t>(it - ids.begin());
+      if (mid == begin || mid == end) mid = begin + (end - begin) / 2;
+    }
+    nodes_[index].first = static_cast<std::uint32_t>(order_.size());
+    build(items, ids, begin, mid, index, depth + 1);
+    const std::uint32_t second = build(items, ids, mid, end, index, depth + 1);
+    node& n = nodes_[index];
+    n.second = second;
+    n.count = end - begin;
+    n.bounds = unite(nodes_[index + 1].bounds, nodes_[second].bounds);
+    return index;
+  }
+
+  std::vector<node> nodes_;
+  std::vector<std::uint32_t> order_;
+  std::vector<std::uint32_t> leaf_of_;
+};
+
+}  // namespace mcrt
