@@ -20,13 +20,14 @@ that way, per selection (each selection's variance scales the same way).
 
 The scenes (seeded, deterministic):
   lights_N: a 20 x 20 diffuse floor (albedo 0.5) with 40 diffuse boxes on
-    it, and N small emitters (triangles and quads, 0.02 to 0.2 across, at
-    heights 0.05 to 3 over the floor, facing anywhere in the lower
-    hemisphere), their radiance log-uniform over three decades; the camera
-    looks down at the floor from 12 units.
-  mesh_light: the same floor and boxes under a wavy emissive sheet of
-    2 x 80 x 80 = 12800 triangles (radiance varying along it) and 20 small
-    bright triangles.
+    it, and N small emitters (triangles and quads, 0.3 / sqrt(N / 10) across
+    within a factor 3, at
+    heights 0.05 to 3 over the floor, facing down within 32 degrees), their
+    radiance log-uniform over three decades; the camera looks down at the
+    floor from 12 units and sees only the lights' backs.
+  mesh_light: the same floor and boxes beside a wavy emissive curtain of
+    2 x 80 x 80 = 12800 triangles (radiance varying along it), and 20 small
+    lights.
 """
 import argparse
 import json
@@ -72,9 +73,14 @@ def small_lights(rng, n, spread=9.0):
     out = []
     for _ in range(n):
         c = (rng.uniform(-spread, spread), rng.uniform(0.05, 3.0), rng.uniform(-spread, spread))
-        size = rng.uniform(0.02, 0.2)
-        # A normal in the lower hemisphere (the light faces down, at any angle).
-        z = -rng.uniform(0.05, 1.0)
+        # Sizes shrink as 1 / sqrt(N): the lights' total area (and power)
+        # is the same for every N, and the camera sees few of them.
+        size = rng.uniform(0.5, 1.5) * 0.3 / math.sqrt(max(n, 10) / 10)
+        # A normal within 32 degrees of straight down: the camera above sees
+        # only the lights' backs, so that the image's error is the floor's
+        # (the light selections'), not the pixels' coverage of bright
+        # emitters.
+        z = -rng.uniform(0.85, 1.0)
         phi = rng.uniform(0, 2 * math.pi)
         r = math.sqrt(1 - z * z)
         nrm = np.array([r * math.cos(phi), z, r * math.sin(phi)])
@@ -100,26 +106,26 @@ def small_lights(rng, n, spread=9.0):
 
 
 def mesh_light(rng, k=80):
-    # A wavy sheet over [-6, 6]^2 at height ~3.5, emitting downwards, in 8
-    # strips of different radiance.
+    # A wavy curtain at x ~ -9 (y from 0.2 to 4, z over [-9, 9]) emitting
+    # towards +x, in 8 strips of different radiance: 2 x 80 x 80 triangles.
     out = []
     strips = 8
     for s in range(strips):
         L = 10 ** rng.uniform(-0.5, 1.0)
-        z0 = -6 + 12 * s / strips
+        z0 = -9 + 18 * s / strips
         rows = k // strips
         pts, idx = [], []
         for j in range(rows + 1):
             for i in range(k + 1):
-                x = -6 + 12 * i / k
-                z = z0 + (12 / strips) * j / rows
-                y = 3.5 + 0.4 * math.sin(1.3 * x) * math.cos(0.9 * z)
+                y = 0.2 + 3.8 * i / k
+                z = z0 + (18 / strips) * j / rows
+                x = -9 + 0.5 * math.sin(1.3 * y) * math.cos(0.9 * z)
                 pts.append((x, y, z))
         for j in range(rows):
             for i in range(k):
                 a = j * (k + 1) + i
                 b, c, d = a + 1, a + k + 1, a + k + 2
-                idx += [a, c, b, b, c, d]  # normal -y
+                idx += [a, b, c, b, d, c]  # normal +x
         ps = ' '.join(f'{x:.5f} {y:.5f} {z:.5f}' for x, y, z in pts)
         out.append('AttributeBegin\n'
                    f'AreaLightSource "diffuse" "rgb L" [ {L:.4f} {L:.4f} {L:.4f} ]\n'
@@ -152,10 +158,12 @@ def read_exr(path):
     return np.asarray(read_rgb(path), dtype=np.float64)
 
 
-def render(mcrt, scene, out, spp, seed, select, threads):
+def render(mcrt, scene, out, spp, seed, select, threads, max_depth=0):
     stats = out + '.json'
     cmd = [mcrt, 'render', scene, '-o', out, '--spp', str(spp), '--seed', str(seed), '--light-select', select,
            '--quiet', '--stats', stats]
+    if max_depth:
+        cmd += ['--max-depth', str(max_depth)]
     if threads:
         cmd += ['--threads', str(threads)]
     subprocess.run(cmd, check=True)
@@ -174,6 +182,7 @@ def main():
     ap.add_argument('--select', default='power,pbrt-bvh,bvh')
     ap.add_argument('--only', default='')
     ap.add_argument('--threads', type=int, default=0)
+    ap.add_argument('--max-depth', type=int, default=0, help='override the files\' maxdepth (1: direct light)')
     a = ap.parse_args()
     names = write_scenes(a.outdir)
     if a.what == 'scenes':
@@ -185,9 +194,9 @@ def main():
         if a.only and name not in a.only.split(','):
             continue
         scene = os.path.join(a.outdir, name + '.pbrt')
-        ref_path = os.path.join(a.outdir, f'{name}_ref{a.ref_spp}.exr')
+        ref_path = os.path.join(a.outdir, f'{name}_d{a.max_depth}_ref{a.ref_spp}.exr')
         if not os.path.exists(ref_path):
-            t = render(a.mcrt, scene, ref_path, a.ref_spp, 1000, 'bvh', a.threads)
+            t = render(a.mcrt, scene, ref_path, a.ref_spp, 1000, 'bvh', a.threads, a.max_depth)
             print(f'{name}: reference {a.ref_spp} spp in {t:.1f} s', file=sys.stderr)
         ref = read_exr(ref_path)
         res = {}
@@ -195,8 +204,8 @@ def main():
         per = {s: {'t': [], 'mse': []} for s in selects}
         for seed in range(a.seeds):
             for s in selects:
-                out = os.path.join(a.outdir, f'{name}_{s}_{seed}.exr')
-                t = render(a.mcrt, scene, out, a.spp, seed + 1, s, a.threads)
+                out = os.path.join(a.outdir, f'{name}_d{a.max_depth}_{s}_{seed}.exr')
+                t = render(a.mcrt, scene, out, a.spp, seed + 1, s, a.threads, a.max_depth)
                 img = read_exr(out)
                 per[s]['t'].append(t)
                 per[s]['mse'].append(float(np.mean((img - ref) ** 2)))

@@ -77,6 +77,9 @@ def parse(argv):
                         "samples/s and efficiency of mcrt and Mitsuba llvm_ad_rgb (and scalar_rgb), interleaved")
     t.add_argument("--triangles", type=int, default=1_300_000,
                    help="at least this many mesh triangles (an icosphere: 20 * 4^level; default %(default)s)")
+    t.add_argument("--throughput-scene", metavar="FILE.pbrt",
+                   help="a pbrt-v4 file instead of the generated mesh scene (e.g. bench/many_lights.py's); "
+                        "--mcrt-config then names mcrt's configurations")
     t.add_argument("--rounds", type=int, default=3, help="interleaved rounds (default %(default)s)")
     t.add_argument("--ref-pass-spp", type=int, default=64,
                    help="spp of each pass of Mitsuba's reference (default %(default)s)")
@@ -96,6 +99,11 @@ def parse(argv):
         a.max_depth = 5 if a.max_depth is None else a.max_depth
         a.out = Path(a.out).resolve() if a.out else ROOT / "build" / "mitsuba-throughput"
         a.mcrt = Path(a.mcrt).resolve()
+        a.throughput_scene = Path(a.throughput_scene).resolve() if a.throughput_scene else None
+        configs = [c.split("=", 1) for c in a.mcrt_config]
+        if any(len(c) != 2 or not c[0] for c in configs):
+            p.error('--mcrt-config takes NAME="FLAGS"')
+        a.configs = [(n, f.split()) for n, f in configs]
         if a.ref_spp % (2 * a.ref_pass_spp):
             p.error("--ref-spp must be a multiple of 2 x --ref-pass-spp (two halves of whole passes)")
         return a

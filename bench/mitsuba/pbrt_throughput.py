@@ -205,10 +205,13 @@ def ref_check(mc, mc_meta, mt, mt_meta):
 
 def markdown(r):
     w, h, spp = r["size"][0], r["size"][1], r["spp"]
-    L = [f"Scene: `{r['scene']}` ({r['mesh']['triangles']:,} mesh triangles + 12 wall and light triangles), "
+    what = (f"{r['mesh']['triangles']:,} mesh triangles + 12 wall and light triangles" if r["mesh"]["triangles"]
+            else "the file's own shapes and lights")
+    first = r["configs"][0]
+    L = [f"Scene: `{r['scene']}` ({what}), "
          f"{w}x{h}, {spp} spp, path maxdepth {r['max_depth']}, box filter, independent sampler, "
          f"{r['threads']} threads each.", "",
-         f"Loads: mcrt {r['summary']['mcrt']['load_seconds_median']:.2f} s (median process wall time minus "
+         f"Loads: mcrt {r['summary'][first]['load_seconds_median']:.2f} s (median process wall time minus "
          f"render_seconds: parse, PLY, BVH build, EXR write); Mitsuba `{LLVM}` mi.load_dict "
          f"{r['mitsuba_load_seconds'][LLVM]:.2f} s"
          + (f", `scalar_rgb` {r['mitsuba_load_seconds']['scalar_rgb']:.2f} s" if "scalar_rgb" in
@@ -261,7 +264,14 @@ def main(a):
     t0 = time.time()
     log = lambda msg: print(f"[{time.time() - t0:7.1f} s] {msg}", flush=True, file=__import__("sys").stderr)
     a.out.mkdir(parents=True, exist_ok=True)
-    scene, mesh = mesh_scene.write(a.out, a.triangles, a.size, a.spp, a.max_depth, log)
+    if a.throughput_scene:
+        # A given file (its own lights and meshes): identified by its text.
+        import hashlib  # noqa: PLC0415
+        scene = a.throughput_scene
+        mesh = {"ply_sha256": hashlib.sha256(scene.read_bytes()).hexdigest(), "triangles": None}
+    else:
+        scene, mesh = mesh_scene.write(a.out, a.triangles, a.size, a.spp, a.max_depth, log)
+    mcrt_configs = a.configs or MCRT_CONFIGS
     w = h = a.size
     mcrt = Mcrt(a.mcrt, a.threads, lambda purpose, cmd: log(f"{purpose}: {cmd}"))
     tt = time.time()
@@ -316,7 +326,7 @@ def main(a):
     _mcrt(mcrt, scene, a.out / "warm.exr", a.spp, 0, w, h, [], a.max_depth, "warm-up")
     for v in variants:
         mi_render(v, mi_scenes[v], a.spp, 0)
-    items = [("mcrt", n, f) for n, f in MCRT_CONFIGS] + [("mitsuba", f"mitsuba {v}", v) for v in variants]
+    items = [("mcrt", n, f) for n, f in mcrt_configs] + [("mitsuba", f"mitsuba {v}", v) for v in variants]
     runs = []
     for k in range(a.rounds):
         seed = k + 1

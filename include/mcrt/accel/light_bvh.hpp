@@ -84,6 +84,7 @@ struct light_bounds {
   direction_cone normals;     // the emitting normals' cone (theta_o)
   float cos_theta_e = 0.0f;   // cos of the emission's spread beyond a normal: pi/2 for a lambertian emitter
   float phi = 0.0f;           // flux (here: pi * area * luminance of the radiance)
+  vec3 centre{0.0f};          // one light's centre on its surface (its centroid; a sphere's centre)
 };
 
 inline light_bounds unite(const light_bounds& a, const light_bounds& b) {
@@ -122,6 +123,7 @@ class light_bvh {
     if (ids.empty()) return;
     nodes_.reserve(2 * ids.size());
     order_.reserve(ids.size());
+    slots_.reserve(ids.size());
     build(items, ids, 0, static_cast<std::uint32_t>(ids.size()), none, 0);
   }
 
@@ -129,7 +131,21 @@ class light_bvh {
   // a range is halved instead of split by cost, so 2^24 lights fit.
   static constexpr std::size_t max_depth = 96;
 
+  // What a selection needs of each light to weigh it against the others of
+  // a small subtree, in the leaves' order (slot i: order()[i]), beside each
+  // other in memory: its box, its centre, emitting normal and flux, and the
+  // square of its box's half diagonal (its size).
+  struct slot {
+    aabb box;
+    vec3 centre{0.0f};
+    vec3 normal{0.0f, 0.0f, 1.0f};
+    float phi = 0.0f;
+    float r2 = 0.0f;
+    bool all_directions = false;  // emits every way (a sphere): no normal
+  };
+
   bool empty() const { return nodes_.empty(); }
+  const std::vector<slot>& slots() const { return slots_; }
   const std::vector<node>& nodes() const { return nodes_; }
   // The items in the leaves' order (a subtree's are contiguous).
   const std::vector<std::uint32_t>& order() const { return order_; }
@@ -167,6 +183,9 @@ class light_bvh {
       nodes_[index].count = 1;
       order_.push_back(item);
       leaf_of_[item] = index;
+      const light_bounds& b = items[item];
+      const vec3 half = 0.5f * (b.box.hi - b.box.lo);
+      slots_.push_back({b.box, b.centre, b.normals.w, b.phi, glm::dot(half, half), b.normals.cos_theta < 0.0f});
       return index;
     }
     light_bounds all;
@@ -225,6 +244,7 @@ class light_bvh {
   std::vector<node> nodes_;
   std::vector<std::uint32_t> order_;
   std::vector<std::uint32_t> leaf_of_;
+  std::vector<slot> slots_;
 };
 
 }  // namespace mcrt

@@ -159,7 +159,14 @@ inline light_bounds bounds_of(const light& l, float phi) {
     b.cos_theta_e = 0.0f;
     if constexpr (std::is_same_v<Shape, sphere>) {
       b.normals = direction_cone::entire_sphere();
+      b.centre = s.shape.center;
     } else {
+      if constexpr (std::is_same_v<Shape, triangle>)
+        b.centre = (s.shape.vertex(0) + s.shape.vertex(1) + s.shape.vertex(2)) / 3.0f;
+      else if constexpr (std::is_same_v<Shape, rect>)
+        b.centre = s.shape.corner + 0.5f * (s.shape.e1 + s.shape.e2);
+      else
+        b.centre = s.shape.center;
       vec3 ng;
       if constexpr (std::is_same_v<Shape, triangle>)
         ng = s.shape.normal();

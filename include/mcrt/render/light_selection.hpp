@@ -15,13 +15,17 @@
 //     root down, each child with the probability of its importance at the
 //     point (render/light_importance.hpp), so P(k) is the product of the
 //     choices on the way to light k. pbrt_bvh is pbrt-v4's BVHLightSampler
-//     as it ships (its importance at every node, a receiver of either
-//     side); bvh is mcrt's: the same tree, pbrt-v4's importance of the
-//     nodes holding more than `exact_cluster` lights (with cos+ at a
-//     receiver that only reflects), and below them each light's exact
-//     importance, pi L times its projected solid angle above the horizon:
-//     the last choices, among the lights nearest the point, by the lights'
-//     true unoccluded contributions to a diffuse receiver.
+//     as it ships (its importance at every node down to the leaves, a
+//     receiver of either side); bvh is mcrt's: pbrt-v4's importance (with
+//     cos+ at a receiver that only reflects) down to the first node of at
+//     most `cluster_size` lights, and there one choice among them by each
+//     light's own contribution (leaf_weight: as a point light from its
+//     centre with its own normal, or exactly where it is near), instead of
+//     five more binary choices between boxes. A box's importance bounds its
+//     cosines and guesses its distance; near the point, where the
+//     contributions that matter are, that is what misleads the choice, and
+//     the lights' own positions and normals do not (the variance each
+//     leaves: bench/light_select_variance.cpp, docs/light-selection.md).
 // With at most `linear_limit` emitters (or without the scene's light tree),
 // power and uniform consider only the lights that can offer the point a
 // sample (`faces`: a one-sided light seen from behind is left out, so no
@@ -57,9 +61,10 @@ class light_selection {
  public:
   // Up to this many emitters, power and uniform walk them all (facing ones only).
   static constexpr std::size_t linear_limit = 8;
-  // bvh: a node with at most this many lights has them chosen by their
-  // exact importance (bench/light_select_study.sh measured 1, 2, 4, 8).
-  static constexpr std::uint32_t exact_cluster = 4;
+  // bvh: a node with at most this many lights has them chosen one by one
+  // by their own importance (bench/light_select_variance.cpp measured 8 to
+  // 128: see docs/light-selection.md).
+  static constexpr std::uint32_t cluster_size = 32;
 
   // o: the shading point; n: the unit normal of its surface (for the
   // cosine-aware strategies' densities and the importance). tree: the
@@ -175,45 +180,57 @@ class light_selection {
   // and the one pdf() multiplies by are the same float.
 
   // The lights of a bvh node small enough to be weighed one by one.
-  bool is_cluster(const node& nd) const { return how_ == light_choice::bvh && nd.count <= exact_cluster; }
+  bool is_cluster(const node& nd) const { return how_ == light_choice::bvh && nd.count <= cluster_size; }
 
   const emitter& item(std::uint32_t slot) const { return emitters_[tree_->order()[slot]]; }
 
-  // The exact importance of the light in slot (bvh), or its bounds'
-  // estimate where the shape has no closed form (disks).
-  float leaf_weight(std::uint32_t slot, const node& leaf) const {
-    const emitter& e = item(slot);
-    const double x = exact_importance(lights_[e.light], e.power, o_, n_, both_sides_);
-    if (x < 0.0) return bounds_importance(leaf.bounds, o_, n_, both_sides_);
-    return x < double(FLT_MAX) ? float(x) : FLT_MAX;
+  // bvh's weight of the light in `slot` within its cluster: its
+  // contribution to a diffuse receiver at the point, as a point light,
+  // phi cos+(theta_l) cos+(theta_r) / d^2 from its centre (cos_l = 1 for a
+  // sphere; |cos theta_r| where the surface transmits); within 4 times its
+  // size of the point, where that is far off, the exact pi L Omega_proj+
+  // (light_importance.hpp; its bounds' estimate for a disk).
+  float leaf_weight(std::uint32_t slot) const {
+    const light_bvh::slot& s = tree_->slots()[slot];
+    const vec3 v = s.centre - o_;
+    const float d2 = glm::dot(v, v);
+    if (d2 < 16.0f * s.r2) {
+      const emitter& e = item(slot);
+      const double x = exact_importance(lights_[e.light], e.power, o_, n_, both_sides_);
+      if (x >= 0.0) return x < double(FLT_MAX) ? float(x) : FLT_MAX;
+      light_bounds b;
+      b.box = s.box;
+      b.normals = s.all_directions ? direction_cone::entire_sphere() : direction_cone{s.normal, 1.0f};
+      b.phi = s.phi;
+      return bounds_importance(b, o_, n_, both_sides_);
+    }
+    const float inv_d = 1.0f / std::sqrt(d2);
+    const float cos_l = s.all_directions ? 1.0f : -glm::dot(v, s.normal) * inv_d;
+    const float c = glm::dot(v, n_) * inv_d;
+    const float cos_r = both_sides_ ? std::abs(c) : c;
+    if (!(cos_l > 0.0f) || !(cos_r > 0.0f)) return 0.0f;
+    return s.phi * cos_l * cos_r / d2;
   }
 
   // A cluster's lights' weights (w[i] for slot first + i) and their sum.
-  float cluster_weights(const node& nd, std::array<float, exact_cluster>& w) const {
+  float cluster_weights(const node& nd, std::array<float, cluster_size>& w) const {
     float sum = 0.0f;
-    const std::vector<node>& nodes = tree_->nodes();
     for (std::uint32_t i = 0; i < nd.count; ++i) {
-      const std::uint32_t slot = nd.first + i;
-      w[i] = leaf_weight(slot, nodes[tree_->leaf_of(tree_->order()[slot])]);
+      w[i] = leaf_weight(nd.first + i);
       sum += w[i];
     }
     return sum;
   }
 
-  // A node's weight at the point under the selection's measure.
+  // A node's weight at the point under the selection's measure (bvh:
+  // pbrt-v4's importance, with cos+ at a surface that only reflects).
   float node_weight(const node& nd) const {
     switch (how_) {
       case light_choice::power: return nd.bounds.phi;
       case light_choice::uniform: return static_cast<float>(nd.count);
       case light_choice::pbrt_bvh: return bounds_importance(nd.bounds, o_, n_, true);
       case light_choice::bvh:
-      default: {
-        if (nd.count <= exact_cluster) {
-          std::array<float, exact_cluster> w;
-          return cluster_weights(nd, w);
-        }
-        return bounds_importance(nd.bounds, o_, n_, both_sides_);
-      }
+      default: return bounds_importance(nd.bounds, o_, n_, both_sides_);
     }
   }
 
@@ -231,7 +248,7 @@ class light_selection {
   }
 
   // Chooses within a cluster by its weights; -1 if they are all 0.
-  static int choose_in(const std::array<float, exact_cluster>& w, std::uint32_t count, float sum, float u) {
+  static int choose_in(const std::array<float, cluster_size>& w, std::uint32_t count, float sum, float u) {
     const float target = u * sum;
     float acc = 0.0f;
     int last = -1;
@@ -251,7 +268,7 @@ class light_selection {
     for (;;) {
       const node& nd = nodes[i];
       if (is_cluster(nd)) {
-        std::array<float, exact_cluster> w;
+        std::array<float, cluster_size> w;
         const float sum = cluster_weights(nd, w);
         if (!(sum > 0.0f) || !std::isfinite(sum)) return -1;
         const int c = choose_in(w, nd.count, sum, u);
@@ -295,7 +312,7 @@ class light_selection {
       const std::uint32_t i = path[d];
       const node& nd = nodes[i];
       if (is_cluster(nd)) {
-        std::array<float, exact_cluster> w;
+        std::array<float, cluster_size> w;
         const float sum = cluster_weights(nd, w);
         if (!(sum > 0.0f) || !std::isfinite(sum)) return 0.0f;
         const std::uint32_t c = nodes[leaf].first - nd.first;
@@ -349,11 +366,11 @@ class light_selection {
       const node& nd = nodes[i];
       if (!meets(nd.bounds.box, inv_d)) continue;
       if (is_cluster(nd)) {
-        std::array<float, exact_cluster> w;
+        std::array<float, cluster_size> w;
         float total = -1.0f;  // formed only if the ray meets one of the cluster's lights
         for (std::uint32_t c = 0; c < nd.count; ++c) {
           const std::uint32_t slot = nd.first + c;
-          if (nd.count > 1 && !meets(nodes[tree_->leaf_of(tree_->order()[slot])].bounds.box, inv_d)) continue;
+          if (nd.count > 1 && !meets(tree_->slots()[slot].box, inv_d)) continue;
           if (total < 0.0f) {
             total = cluster_weights(nd, w);
             if (!(total > 0.0f) || !std::isfinite(total)) break;
