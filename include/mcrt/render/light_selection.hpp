@@ -144,6 +144,8 @@ class light_selection {
   // P(k) of the light with index k among the scene's lights (0 when it is
   // not an emitter the selection can choose).
   float probability(std::size_t k) const {
+    // Where every light emits, emitter k is light k: no search.
+    if (k < emitters_.size() && emitters_[k].light == k) return tree_ ? probability_tree(k) : probability_of(emitters_[k]);
     for (std::size_t i = 0; i < emitters_.size(); ++i)
       if (emitters_[i].light == k) return tree_ ? probability_tree(i) : probability_of(emitters_[i]);
     return 0.0f;
@@ -359,12 +361,12 @@ class light_selection {
     };
     std::array<entry, light_bvh::max_depth + 2> stack;
     std::size_t top = 0;
-    stack[top++] = {0, 1.0f};
+    if (meets(nodes[0].bounds.box, inv_d)) stack[top++] = {0, 1.0f};
     float sum = 0.0f;
+    // Every node on the stack has a box the ray meets.
     while (top > 0) {
       const auto [i, p] = stack[--top];
       const node& nd = nodes[i];
-      if (!meets(nd.bounds.box, inv_d)) continue;
       if (is_cluster(nd)) {
         std::array<float, cluster_size> w;
         float total = -1.0f;  // formed only if the ray meets one of the cluster's lights
@@ -385,10 +387,13 @@ class light_selection {
         sum += p * light_pdf(nd.first, dir, known, known_pdf);
         continue;
       }
+      // The children's probabilities only where the ray meets a child.
+      const bool met1 = meets(nodes[i + 1].bounds.box, inv_d), met2 = meets(nodes[nd.second].bounds.box, inv_d);
+      if (!met1 && !met2) continue;
       float p1, p2;
       child_probabilities(nd, i, p1, p2);
-      if (p2 > 0.0f) stack[top++] = {nd.second, p * p2};
-      if (p1 > 0.0f) stack[top++] = {i + 1, p * p1};
+      if (met2 && p2 > 0.0f) stack[top++] = {nd.second, p * p2};
+      if (met1 && p1 > 0.0f) stack[top++] = {i + 1, p * p1};
     }
     return sum;
   }
