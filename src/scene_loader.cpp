@@ -387,9 +387,12 @@ bool is_pbrt_file(const std::string& path) { return path.ends_with(".pbrt") || p
 
 namespace {
 
-loaded_scene load_pbrt_scene(const std::string& path, std::optional<light_sampling> override_strategy) {
+loaded_scene load_pbrt_scene(const std::string& path, std::optional<light_sampling> override_strategy,
+                             const auto_params& ap, bool auto_pilot) {
   pbrt::build_options opt;
   opt.strategy = override_strategy;
+  opt.auto_rule = ap;
+  opt.auto_pilot = auto_pilot;
   opt.decode_image = decode_texture_image;
   pbrt::built_scene b;
   try {
@@ -413,6 +416,8 @@ loaded_scene load_pbrt_scene(const std::string& path, std::optional<light_sampli
   out.light_select = b.light_select;
   out.output = b.film.filename;
   out.file_lights = std::move(b.file_lights);
+  out.auto_lights = b.auto_lights;
+  out.auto_setup_seconds = b.auto_setup_seconds;
   out.filter = b.filter.kind;
   out.filter_radius = b.filter.radius;
   out.filter_sigma = b.filter.sigma;
@@ -423,7 +428,7 @@ loaded_scene load_pbrt_scene(const std::string& path, std::optional<light_sampli
 
 loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy, ellipse_map map,
                         const auto_params& ap, bool auto_pilot, std::span<const auto_receiver> auto_receivers) {
-  if (is_pbrt_file(path)) return load_pbrt_scene(path, override_strategy);
+  if (is_pbrt_file(path)) return load_pbrt_scene(path, override_strategy, ap, auto_pilot);
   const context ctx{path};
   const reader rd{ctx};
   std::ifstream in(path, std::ios::binary);

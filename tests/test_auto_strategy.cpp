@@ -67,6 +67,18 @@ std::vector<config> configs() {
 rect unit_rect() { return xz_rect(-0.5f, 0.5f, -0.4f, 0.4f, 0.0f, true); }
 ellipse unit_disk() { return ellipse::make({0, 0, 0}, {0.5f, 0, 0}, {0, 0, 0.5f}); }
 sphere unit_sphere() { return sphere{vec3(0.0f, 0.5f, 0.0f), 0.4f}; }
+// A scalene triangle of about the rectangle's size facing down (-y), its
+// vertices in that winding (back: the other way round, facing up).
+triangle make_triangle(const vec3& a, const vec3& b, const vec3& c) {
+  auto m = std::make_shared<triangle_mesh>();
+  m->p = {a, b, c};
+  m->indices = {0, 1, 2};
+  return triangle{m, 0};
+}
+triangle unit_triangle(bool facing_up = false) {
+  const vec3 a(-0.5f, 0.0f, -0.4f), b(0.6f, 0.0f, -0.3f), c(-0.1f, 0.0f, 0.5f);
+  return facing_up ? make_triangle(a, c, b) : make_triangle(a, b, c);
+}
 
 // The model's v_area and v_sa (four-point rules) against their Monte-Carlo
 // values (2e5 samples: ~1 % of a variance of order 1). The model only has
@@ -160,6 +172,9 @@ TEST(AutoStrategy, ModelVariancesNearRect) {
 TEST(AutoStrategy, ModelVariancesNearDisk) {
   check_model_near<ellipse, ellipse_area_sampler, ellipse_solid_angle_sampler>(unit_disk());
 }
+TEST(AutoStrategy, ModelVariancesNearTriangle) {
+  check_model_near<triangle, triangle_area_sampler, triangle_solid_angle_sampler>(unit_triangle());
+}
 
 // v_area by a midpoint rule over the light's surface (N x N points at
 // point(s, t), (s, t) in the unit square, uniform by area), in double.
@@ -250,6 +265,40 @@ TEST(AutoStrategy, PeakVarianceIntegrated) {
   EXPECT_EQ(peaked, 12) << "every receiver here is one where g peaks between the rule's points";
 }
 
+// The same for a triangle (its chords through three half-planes, its
+// nearest point on an edge or inside): under it facing it and across it,
+// tilted, beside an edge and beside a vertex, within 4 % of the midpoint
+// rule over the triangle (the unit square mapped by area,
+// square_to_triangle), where g peaks between the rule's points. The
+// model's Omega_proj there is Lambert's for the triangle.
+TEST(AutoStrategy, PeakVarianceIntegratedTriangle) {
+  const triangle t = unit_triangle();
+  const glm::dvec3 a(t.vertex(0)), b(t.vertex(1)), c(t.vertex(2));
+  const auto on_triangle = [&](double s, double u) {
+    const double r = std::sqrt(s), b0 = 1.0 - r, b1 = u * r;
+    return b0 * a + b1 * b + (1.0 - b0 - b1) * c;
+  };
+  const std::vector<config> receivers = {
+      {"under_middle_up", {0.0f, -0.04f, 0.0f}, {0, 1, 0}},
+      {"under_middle_across", {0.05f, -0.05f, -0.05f}, {1, 0, 0}},
+      {"under_tilted", {-0.1f, -0.03f, -0.1f}, glm::normalize(vec3(1, 1, 0))},
+      {"beside_edge", {0.0f, -0.02f, -0.42f}, {0, 0, 1}},
+      {"beside_vertex", {0.66f, -0.03f, -0.33f}, glm::normalize(vec3(-1, 0, 0.2f))},
+  };
+  const std::vector<glm::dvec3> poly{a, b, c};
+  int peaked = 0;
+  for (const config& r : receivers) {
+    const auto_choice m = auto_model(t, r.o, r.n);
+    if (!m.peaked()) continue;
+    ++peaked;
+    const double ref = dense_v_area(on_triangle, r.o, r.n, t.normal(), t.vertex(0));
+    EXPECT_NEAR(m.v_area(), ref, 0.04 * ref) << r.name;
+    const double exact = test::clipped_polygon_irradiance(glm::dvec3(r.o), glm::dvec3(r.n), poly, 1.0);
+    EXPECT_NEAR(m.omega_proj(), exact, 1e-3 * exact) << r.name;
+  }
+  EXPECT_GE(peaked, 4) << "receivers where g peaks between the rule's points";
+}
+
 // Receivers all but touching a planar light, 1e-3 to 1e-42 of its size
 // under its middle (down to a subnormal height), facing it and with the
 // normal across it: the model stays finite and lit (there 1 / r^4 at the
@@ -265,6 +314,7 @@ TEST(AutoStrategy, ModelFiniteWhereReceiverTouchesLight) {
   for (const float h : {1e-3f, 1e-10f, 1e-15f, 1e-20f, 1e-30f, 1e-38f, 1e-42f}) {
     for (const bool disk : {false, true}) {
       const planar_rule rule = disk ? planar_rule(unit_disk()) : planar_rule(unit_rect());
+      const planar_rule tri(unit_triangle());
       for (const vec3 n : {vec3(0, 1, 0), vec3(1, 0, 0)}) {
         const vec3 o(0.1f, -h, 0.05f);
         char name_c[64];
@@ -278,6 +328,15 @@ TEST(AutoStrategy, ModelFiniteWhereReceiverTouchesLight) {
         EXPECT_LE(m.v_area(), std::numeric_limits<float>::max()) << name;
         EXPECT_TRUE(std::isfinite(m.v_solid_angle())) << name;
         EXPECT_NE(rule.choose(o, n, p), light_sampling::area) << name;
+        if (disk) continue;
+        // The triangle (o is over its inside too).
+        const auto_choice mt = tri.fine(o, n);
+        ASSERT_TRUE(mt.peaked()) << name << " (triangle)";
+        EXPECT_NEAR(mt.omega_proj(), half_space, 0.02 * half_space) << name << " (triangle)";
+        EXPECT_GT(mt.v_area(), 0.0f) << name << " (triangle)";
+        EXPECT_LE(mt.v_area(), std::numeric_limits<float>::max()) << name << " (triangle)";
+        EXPECT_TRUE(std::isfinite(mt.v_solid_angle())) << name << " (triangle)";
+        EXPECT_NE(tri.choose(o, n, p), light_sampling::area) << name << " (triangle)";
       }
     }
   }
@@ -286,6 +345,9 @@ TEST(AutoStrategy, ModelFiniteWhereReceiverTouchesLight) {
 TEST(AutoStrategy, ModelVariancesRect) { check_model<rect, rect_area_sampler, rect_solid_angle_sampler>(unit_rect()); }
 TEST(AutoStrategy, ModelVariancesDisk) {
   check_model<ellipse, ellipse_area_sampler, ellipse_solid_angle_sampler>(unit_disk());
+}
+TEST(AutoStrategy, ModelVariancesTriangle) {
+  check_model<triangle, triangle_area_sampler, triangle_solid_angle_sampler>(unit_triangle());
 }
 
 }  // namespace
@@ -461,8 +523,8 @@ TEST(AutoStrategy, ReceiverModelsServeEveryParams) {
 // 0, at most 1e-3 of the samples). 20000 random receivers (position and
 // normal) around each shape; every strategy gets chosen somewhere.
 template <class Auto, class Shape>
-void check_agreement(const Shape& shape, const auto_params& params = {}, bool area_expected = true) {
-  const Auto s(shape, params);
+void check_agreement(const Shape& shape, const auto_params& params = {}, bool area_expected = true, bool back = false) {
+  const Auto s(shape, params, back);
   pcg32 rng(21, 5);
   int chosen[3] = {0, 0, 0}, sampled = 0, off = 0;
   for (int i = 0; i < 20000; ++i) {
@@ -514,6 +576,13 @@ TEST(AutoStrategy, PdfAgreesDisk) {
   check_agreement<ellipse_auto_sampler>(ellipse::make({0, 0, 0}, {1.0f, 0, 0}, {0, 0, 0.8f}));
 }
 TEST(AutoStrategy, PdfAgreesSphere) { check_agreement<sphere_auto_sampler>(sphere{vec3(0.0f, 0.6f, 0.0f), 0.5f}); }
+// Triangles: its front, and the back side of one facing away (the other
+// half of a two-sided light), each seen from below.
+TEST(AutoStrategy, PdfAgreesTriangle) {
+  const vec3 a(-1.0f, 0.0f, -0.8f), b(1.2f, 0.0f, -0.6f), c(-0.2f, 0.0f, 1.0f);
+  check_agreement<triangle_auto_sampler>(make_triangle(a, b, c));
+  check_agreement<triangle_auto_sampler>(make_triangle(a, c, b), {}, true, true);
+}
 // The same with v_rest from the image's noise (V = 0.01, L = 1).
 auto_params noise_params(float v = 0.01f) {
   auto_params p;
@@ -526,6 +595,11 @@ TEST(AutoStrategy, PdfAgreesRectImageNoise) {
 }
 TEST(AutoStrategy, PdfAgreesDiskImageNoise) {
   check_agreement<ellipse_auto_sampler>(ellipse::make({0, 0, 0}, {1.0f, 0, 0}, {0, 0, 0.8f}), noise_params());
+}
+TEST(AutoStrategy, PdfAgreesTriangleImageNoise) {
+  const vec3 a(-1.0f, 0.0f, -0.8f), b(1.2f, 0.0f, -0.6f), c(-0.2f, 0.0f, 1.0f);
+  check_agreement<triangle_auto_sampler>(make_triangle(a, b, c), noise_params());
+  check_agreement<triangle_auto_sampler>(make_triangle(a, c, b), noise_params(), true, true);
 }
 TEST(AutoStrategy, PdfAgreesSphereImageNoise) {
   // Area sampling of a sphere (dearer than its cone, and noisier where
@@ -573,6 +647,7 @@ void check_monotone(const Shape& shape, bool sphere_shape) {
     auto cost = [&](light_sampling c) {
       auto_costs::shape_costs k = auto_costs::rect;
       if constexpr (std::is_same_v<Shape, ellipse>) k = auto_costs::ellipse;
+      if constexpr (std::is_same_v<Shape, triangle>) k = auto_costs::triangle;
       if constexpr (std::is_same_v<Shape, sphere>) {
         const vec3 v = shape.center - o;
         k = glm::dot(v, n) >= shape.radius ? auto_costs::sphere_above : auto_costs::sphere_crossing;
@@ -601,6 +676,9 @@ TEST(AutoStrategy, NeverDearerAsTheImageGetsNoisierRect) {
 }
 TEST(AutoStrategy, NeverDearerAsTheImageGetsNoisierDisk) {
   check_monotone(ellipse::make({0, 0, 0}, {1.0f, 0, 0}, {0, 0, 0.8f}), false);
+}
+TEST(AutoStrategy, NeverDearerAsTheImageGetsNoisierTriangle) {
+  check_monotone(make_triangle({-1.0f, 0.0f, -0.8f}, {1.2f, 0.0f, -0.6f}, {-0.2f, 0.0f, 1.0f}), false);
 }
 TEST(AutoStrategy, NeverDearerAsTheImageGetsNoisierSphere) {
   check_monotone(sphere{vec3(0.0f, 0.6f, 0.0f), 0.5f}, true);
@@ -639,6 +717,10 @@ TEST(AutoStrategy, ChiSquare) {
   check_chi2<ellipse_auto_sampler>(disk, {0.3f, -0.2f, 0.1f}, grazing, light_sampling::solid_angle, 33);
   check_chi2<ellipse_auto_sampler>(disk, {0.3f, -3.0f, 0.1f}, up, light_sampling::area, 36);
   check_chi2<sphere_auto_sampler>(sphere{vec3(0), 0.5f}, {0.0f, -3.0f, 0.0f}, up, light_sampling::solid_angle, 34);
+  const triangle tri = make_triangle({-2.0f, 0.0f, -1.6f}, {2.4f, 0.0f, -1.2f}, {-0.4f, 0.0f, 2.0f});
+  check_chi2<triangle_auto_sampler>(tri, {0.0f, -20.0f, 0.0f}, up, light_sampling::area, 37);
+  check_chi2<triangle_auto_sampler>(tri, {0.3f, -0.2f, 0.1f}, grazing, light_sampling::projected_solid_angle, 38);
+  check_chi2<triangle_auto_sampler>(tri, {0.3f, -0.3f, 0.1f}, up, light_sampling::solid_angle, 39);
 }
 
 }  // namespace
@@ -827,6 +909,12 @@ TEST(AutoTable, AgreesWithTheRuleAtMostReceivers) {
   EXPECT_GE(tabulated_agreement<ellipse_auto_sampler>(ellipse::make({0, 0, 0}, {1.0f, 0, 0}, {0, 0, 0.8f}), noise_params()),
             0.9);
   EXPECT_GE(tabulated_agreement<sphere_auto_sampler>(sphere{vec3(0.0f, 0.6f, 0.0f), 0.5f}, noise_params()), 0.9);
+  // A triangle's table, without the symmetry (both signs of each lateral coordinate).
+  const triangle tri = make_triangle({-1.0f, 0.0f, -0.8f}, {1.2f, 0.0f, -0.6f}, {-0.2f, 0.0f, 1.0f});
+  const double triangle_share = tabulated_agreement<triangle_auto_sampler>(tri);
+  EXPECT_GE(triangle_share, 0.9);
+  EXPECT_GE(tabulated_agreement<triangle_auto_sampler>(tri, noise_params()), 0.9);
+  std::printf("tabulated = rule at %.3f of the receivers (triangle)\n", triangle_share);
   ::testing::Test::RecordProperty("rect_share", std::to_string(rect_share));
   ::testing::Test::RecordProperty("disk_share", std::to_string(disk_share));
   ::testing::Test::RecordProperty("sphere_share", std::to_string(sphere_share));

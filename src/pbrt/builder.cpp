@@ -1,5 +1,6 @@
 #include "pbrt/builder.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -655,11 +656,26 @@ class builder {
     return static_cast<std::uint32_t>(out_.world.materials.size() - 1);
   }
 
-  light_sampling strategy_for(const std::string& shape, const file_loc& loc, light_sampling def) const {
+  // --light-sampling, else the shape's default; `auto` in the noise
+  // pilot's scene is the default (the shape's cheapest strategy).
+  light_sampling strategy_for(light_sampling def) const {
     if (!opt_.strategy) return def;
-    if (*opt_.strategy == light_sampling::automatic)
-      refuse(loc, "--light-sampling auto: not available for pbrt-v4 scenes (a " + shape + " light)");
+    if (*opt_.strategy == light_sampling::automatic && opt_.auto_pilot) return def;
     return *opt_.strategy;
+  }
+  bool automatic() const { return opt_.strategy == light_sampling::automatic; }
+
+  // `auto`'s params for a light of radiance L (the mean of its channels,
+  // as for JSON scenes), and an `auto` light built by make() with them, its
+  // set-up timed.
+  template <class Make>
+  light auto_light(const color& L, Make make) {
+    auto_params p = opt_.auto_rule;
+    p.radiance = (L.r + L.g + L.b) / 3.0f;
+    const auto start = std::chrono::steady_clock::now();
+    light l = make(p);
+    out_.auto_setup_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return l;
   }
 
   // Registers an emitter's light(s): one, or for a two-sided light its
@@ -678,6 +694,7 @@ class builder {
   }
 
   void add_light_only(const light& l, std::uint32_t mat) {
+    if (automatic()) ++out_.auto_lights;
     const auto k = static_cast<std::uint32_t>(out_.world.lights.size());
     out_.world.lights.push_back(l);
     const auto& e = std::get<diffuse_light>(out_.world.materials[mat]);
@@ -751,7 +768,7 @@ class builder {
     auto mesh = std::make_shared<const triangle_mesh>(std::move(m));
     bool emits = false;
     const std::uint32_t mat = shape_material(emits);
-    const light_sampling st = emits ? strategy_for("triangle", p.loc(), light_sampling::area) : light_sampling::area;
+    const light_sampling st = emits ? strategy_for(light_sampling::area) : light_sampling::area;
     for (const triangle& tri : triangles_of(mesh)) {
       if (tri.area() == 0.0f) continue;  // a degenerate triangle is never hit
       out_.world.add(tri, mat);
@@ -763,8 +780,10 @@ class builder {
   }
 
   // A triangle light's strategy (back: its back side's, for a two-sided light).
-  static light triangle_light(const triangle& t, light_sampling st, bool back) {
+  light triangle_light(const triangle& t, light_sampling st, bool back) {
     switch (st) {
+      case light_sampling::automatic:
+        return auto_light(state_.light->L, [&](const auto_params& ap) { return triangle_auto_sampler(t, ap, back); });
       case light_sampling::solid_angle: return triangle_solid_angle_sampler{t, back};
       case light_sampling::projected_solid_angle: return triangle_projected_solid_angle_sampler{t, back};
       case light_sampling::bilinear_solid_angle: return triangle_bilinear_solid_angle_sampler{t, back};
@@ -891,20 +910,24 @@ class builder {
     }
     if (state_.light->twosided) p.fail("a two-sided sphere light is not supported");
     out_.world.add(sp, mat);
-    const light_sampling st = strategy_for("sphere", p.loc(), light_sampling::solid_angle);
+    const light_sampling st = strategy_for(light_sampling::solid_angle);
     add_emitter([&](std::uint32_t mm) { add_light_only(sphere_light(sp, st), mm); }, [](std::uint32_t) {}, false, mat);
   }
 
-  static light sphere_light(const sphere& s, light_sampling st) {
+  light sphere_light(const sphere& s, light_sampling st) {
     switch (st) {
+      case light_sampling::automatic:
+        return auto_light(state_.light->L, [&](const auto_params& ap) { return sphere_auto_sampler(s, ap); });
       case light_sampling::area: return sphere_area_sampler{s};
       case light_sampling::projected_solid_angle:
       case light_sampling::bilinear_solid_angle: return sphere_projected_solid_angle_sampler{s};
       default: return sphere_cone_sampler{s};
     }
   }
-  static light ellipse_light(const ellipse& e, light_sampling st) {
+  light ellipse_light(const ellipse& e, light_sampling st) {
     switch (st) {
+      case light_sampling::automatic:
+        return auto_light(state_.light->L, [&](const auto_params& ap) { return ellipse_auto_sampler(e, ap); });
       case light_sampling::solid_angle: return ellipse_solid_angle_sampler{e};
       case light_sampling::projected_solid_angle: return ellipse_projected_solid_angle_sampler{e};
       case light_sampling::bilinear_solid_angle: return ellipse_bilinear_solid_angle_sampler{e};
@@ -932,7 +955,7 @@ class builder {
     const std::uint32_t mat = shape_material(emits);
     out_.world.add(e, mat);
     if (!emits) return;
-    const light_sampling st = strategy_for("disk", p.loc(), light_sampling::area);
+    const light_sampling st = strategy_for(light_sampling::area);
     add_emitter([&](std::uint32_t mm) { add_light_only(ellipse_light(e, st), mm); },
                 [&](std::uint32_t mm) { add_light_only(ellipse_light(ellipse::make(vec3(c), vec3(a1), vec3(a2), !flip), st), mm); },
                 state_.light->twosided, mat);

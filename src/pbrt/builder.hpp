@@ -55,6 +55,10 @@ struct built_scene {
   // each one's entries in world.emitters, two for a two-sided light (its
   // front and its back, each sampled from its own side).
   std::vector<std::vector<std::uint32_t>> file_lights;
+  // Lights sampled by `auto` (each side of a two-sided light counts), and
+  // the time their set-up took (part of the image's, as for JSON scenes).
+  int auto_lights = 0;
+  double auto_setup_seconds = 0.0;
 };
 
 // Decodes an image file into linear RGB texels (8-bit images are decoded
@@ -67,6 +71,11 @@ struct build_options {
   // Every emitter sampled by this strategy instead of its default (area):
   // --light-sampling.
   std::optional<light_sampling> strategy;
+  // With strategy `auto`: the rule's params (each light's radiance is set
+  // from its own L), and whether this is the noise pilot's scene, whose
+  // lights take their shape's default strategy (its cheapest) instead.
+  auto_params auto_rule;
+  bool auto_pilot = false;
   image_decoder decode_image;
 };
 

@@ -22,6 +22,7 @@
 #include "mcrt/geometry/ellipse.hpp"
 #include "mcrt/geometry/rect.hpp"
 #include "mcrt/geometry/sphere.hpp"
+#include "mcrt/geometry/triangle_mesh.hpp"
 
 namespace mcrt::test {
 
@@ -212,6 +213,17 @@ inline spherical_cap bounding_cap(const dvec3& o, const sphere& s) {
   const double d = glm::length(v), r = static_cast<double>(s.radius);
   if (!(d > r)) return {dvec3(0.0, 0.0, 1.0), 2.0};
   return detail::widened_cap(v / d, std::asin(r / d));
+}
+
+inline spherical_cap bounding_cap(const dvec3& o, const triangle& t) {
+  const dvec3 p[3] = {dvec3(t.vertex(0)), dvec3(t.vertex(1)), dvec3(t.vertex(2))};
+  std::vector<dvec3> dirs;
+  for (const dvec3& q : p) {
+    if (!(glm::length(q - o) > 0.0)) return {dvec3(t.normal()), 2.0};
+    dirs.push_back(glm::normalize(q - o));
+  }
+  return detail::cap_of_planar_convex(o, (p[0] + p[1] + p[2]) / 3.0, glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0])),
+                                      p[0], dirs, 0.0);
 }
 
 // The same with the arguments the other way round.

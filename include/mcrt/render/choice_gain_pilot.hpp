@@ -170,7 +170,7 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
               p.rest_cost = modelled_rest_cost(noise.rays_per_light_sample, noise.paths_per_light_sample,
                                                intersection_cost_per_ray(sc), light_shape_cost<decltype(s.shape)>());
             a.rest_cost = p.rest_cost;
-            const S with_cost(s.shape, p);
+            const S with_cost = s.with_params(p);
             a.image_variance = p.image_variance;
             // kappa <= 1 only weighs the choice's gain down (V_l >= V): where
             // the choice does not pay with V, it is not measured.
@@ -203,7 +203,7 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
             a.image_variance = a.kappa > 0.0 ? v * (1.0 - (1.0 - a.kappa) * a.noise_share) / a.kappa
                                              : double(std::numeric_limits<float>::max());
             p.image_variance = static_cast<float>(std::min(a.image_variance, double(std::numeric_limits<float>::max())));
-            rebuilt = S(s.shape, p);
+            rebuilt = s.with_params(p);
           }
         },
         sc.lights[i]);

@@ -42,7 +42,8 @@ using light = std::variant<rect_area_sampler, rect_solid_angle_sampler, ellipse_
                            rect_bilinear_solid_angle_sampler, ellipse_bilinear_solid_angle_sampler,
                            rect_auto_sampler, ellipse_auto_sampler, sphere_auto_sampler, triangle_area_sampler,
                            triangle_solid_angle_sampler, triangle_projected_solid_angle_sampler,
-                           triangle_bilinear_solid_angle_sampler, triangle_pbrt_sampler, rect_pbrt_sampler>;
+                           triangle_bilinear_solid_angle_sampler, triangle_pbrt_sampler, rect_pbrt_sampler,
+                           triangle_auto_sampler>;
 
 // The strategy a light-sampling class implements (--stats, mcrt samples).
 template <class S>
@@ -62,7 +63,7 @@ constexpr light_sampling strategy_of() {
   else if constexpr (std::is_same_v<S, triangle_pbrt_sampler> || std::is_same_v<S, rect_pbrt_sampler>)
     return light_sampling::pbrt;
   else if constexpr (std::is_same_v<S, rect_auto_sampler> || std::is_same_v<S, ellipse_auto_sampler> ||
-                     std::is_same_v<S, sphere_auto_sampler>)
+                     std::is_same_v<S, sphere_auto_sampler> || std::is_same_v<S, triangle_auto_sampler>)
     return light_sampling::automatic;
   else
     return light_sampling::solid_angle;

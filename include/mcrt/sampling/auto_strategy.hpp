@@ -70,17 +70,21 @@
 #include "mcrt/geometry/ellipse.hpp"
 #include "mcrt/geometry/rect.hpp"
 #include "mcrt/geometry/sphere.hpp"
+#include "mcrt/geometry/triangle_mesh.hpp"
 #include "mcrt/sampling/ellipse_area.hpp"
 #include "mcrt/sampling/auto_table.hpp"
 #include "mcrt/sampling/light_sample.hpp"
 #include "mcrt/sampling/projected_rectangle.hpp"
 #include "mcrt/sampling/projected_spherical_cap.hpp"
 #include "mcrt/sampling/projected_spherical_ellipse.hpp"
+#include "mcrt/sampling/projected_triangle.hpp"
 #include "mcrt/sampling/rect_area.hpp"
 #include "mcrt/sampling/sphere_area.hpp"
 #include "mcrt/sampling/sphere_cone.hpp"
 #include "mcrt/sampling/spherical_ellipse.hpp"
 #include "mcrt/sampling/spherical_rectangle.hpp"
+#include "mcrt/sampling/spherical_triangle.hpp"
+#include "mcrt/sampling/triangle_area.hpp"
 
 namespace mcrt {
 
@@ -139,6 +143,10 @@ struct auto_costs {
   // horizon (a numerical inversion) than above it (closed form).
   static constexpr shape_costs sphere_above{74.0f, 54.0f, 100.0f};
   static constexpr shape_costs sphere_crossing{74.0f, 54.0f, 600.0f};
+  // Triangles (docs/samplers.md: BM_SampleTriangleArea, ...SolidAngle,
+  // ...ProjectedSolidAngle/Up; the area sampler's pdf intersects the
+  // triangle in double).
+  static constexpr shape_costs triangle{84.0f, 535.0f, 799.0f};
   // With nee, a light sample's time inside a render: the cheapest
   // strategy's cost as above, the others' by what they add to a render's
   // time per light sample (bench/strategy_costs.py: nee, Sobol, one thread,
@@ -155,6 +163,11 @@ struct auto_costs {
   static constexpr shape_costs sphere_crossing_nee{74.0f, 54.0f, 268.0f};
   static const shape_costs& rect_for(const auto_params& p) { return p.pdf_with_sample ? rect_nee : rect; }
   static const shape_costs& ellipse_for(const auto_params& p) { return p.pdf_with_sample ? ellipse_nee : ellipse; }
+  // Triangles with nee: the sample + pdf benchmarks' costs as well (not
+  // measured inside renders; the rectangle's and the ellipse's in-render
+  // differences are 0.4-0.7 of those, so nee's choice leans, if anything,
+  // towards area sampling).
+  static const shape_costs& triangle_for(const auto_params&) { return triangle; }
   static const shape_costs& sphere_for(bool above, const auto_params& p) {
     if (p.pdf_with_sample) return above ? sphere_above_nee : sphere_crossing_nee;
     return above ? sphere_above : sphere_crossing;
@@ -335,7 +348,7 @@ class auto_choice {
   float v_peak_ = -1.0f;  // v_area integrated about g's peak (< 0: not done)
 };
 
-// The rule of a planar light (rectangle or ellipse), with what depends on
+// The rule of a planar light (rectangle, ellipse or triangle), with what depends on
 // the light alone computed once: its centre and half-axes for the delta
 // method, the quadrature points of the coarse and the fine rule (SoA, so
 // the per-point work is a few packed operations), and how to clamp a
@@ -351,7 +364,7 @@ class planar_rule {
 
   explicit planar_rule(const rect& r, const auto_costs::shape_costs& c = auto_costs::rect)
       : costs_(c), center_(r.corner + 0.5f * (r.e1 + r.e2)), E1_(r.e1), E2_(r.e2), nl_(r.n), k_(1.0f / 12.0f),
-        area_(glm::length(glm::cross(r.e1, r.e2))), rect_(true), corner_(r.corner), dual1_(r.e1_dual), dual2_(r.e2_dual),
+        area_(glm::length(glm::cross(r.e1, r.e2))), kind_(kind::rect), corner_(r.corner), dual1_(r.e1_dual), dual2_(r.e2_dual),
         exact_(rect_projected_solid_angle_sampler(r)) {
     // Coarse: 2x2 Gauss points, 1/2 -+ 1/(2 sqrt 3). Fine: 3x3 Gauss-Legendre
     // points (exact for degree 5 in each coordinate), 1/2 -+ sqrt(3/5)/2 and
@@ -371,7 +384,7 @@ class planar_rule {
   }
   explicit planar_rule(const ellipse& e, const auto_costs::shape_costs& c = auto_costs::ellipse)
       : costs_(c), center_(e.center), E1_(e.a1), E2_(e.a2), nl_(e.n), k_(0.25f),
-        area_(pi * glm::length(e.a1) * glm::length(e.a2)), rect_(false),
+        area_(pi * glm::length(e.a1) * glm::length(e.a2)), kind_(kind::ellipse),
         corner_(e.center), dual1_(e.a1_dual), dual2_(e.a2_dual), exact_(ellipse_projected_solid_angle_sampler(e)) {
     // Coarse: one ring of four points at rho = 1/sqrt(2). Fine: three rings
     // by area (rho^2 = 1/2 -+ sqrt(3/5)/2 and 1/2, the 3-point Gauss rule in
@@ -391,6 +404,69 @@ class planar_rule {
     k = 0;
     for (int ring = 0; ring < 3; ++ring)
       for (int i = 0; i < 4; ++i) set(fine_, k++, e.center + rho[ring] * (ring == 1 ? diagonal_dirs[i] : axis_dirs[i]), w[ring]);
+  }
+  // A triangle (its back side where `back`, the other half of a two-sided
+  // light). The delta method's E1, E2 are the edges of the rectangle with
+  // the triangle's covariance about its centroid, Sigma = (1/12) sum_i
+  // d_i d_i^T (d_i the vertices' offsets from the centroid): along its
+  // principal axes, E_i = sqrt(12 lambda_i) e_i. Coarse: the degree-2 rule
+  // of the three points (2/3, 1/6, 1/6) (Strang & Fix). Fine: Dunavant's
+  // 12-point rule of degree 6 ("High degree efficient symmetrical Gaussian
+  // quadrature rules for the triangle", IJNME 21, 1985, table: p = 6).
+  explicit planar_rule(const triangle& t, bool back = false, const auto_costs::shape_costs& c = auto_costs::triangle)
+      : costs_(c), k_(1.0f / 12.0f), area_(t.area()), kind_(kind::triangle), exact_(triangle_projected_solid_angle_sampler(t, back)) {
+    const vec3 v[3] = {t.vertex(0), t.vertex(1), t.vertex(2)};
+    center_ = (v[0] + v[1] + v[2]) / 3.0f;
+    nl_ = back ? -t.normal() : t.normal();
+    corner_ = center_;
+    // The covariance in a frame of the plane, then its principal axes.
+    const onb frame(nl_);
+    double sxx = 0.0, syy = 0.0, sxy = 0.0;
+    for (const vec3& p : v) {
+      const double x = glm::dot(p - center_, frame.u), y = glm::dot(p - center_, frame.v);
+      sxx += x * x / 12.0, syy += y * y / 12.0, sxy += x * y / 12.0;
+    }
+    const double mean = 0.5 * (sxx + syy), dev = std::hypot(0.5 * (sxx - syy), sxy);
+    const double l1 = mean + dev, l2 = std::max(mean - dev, 0.0), th = 0.5 * std::atan2(2.0 * sxy, sxx - syy);
+    const vec3 e1 = float(std::cos(th)) * frame.u + float(std::sin(th)) * frame.v;
+    const vec3 e2 = glm::cross(nl_, e1);
+    // A degenerate triangle has no area and is never a light; the floor
+    // keeps E2's direction defined for a sliver.
+    E1_ = float(std::sqrt(12.0 * l1)) * e1;
+    E2_ = float(std::max(std::sqrt(12.0 * l2), 1e-30)) * e2;
+    dual1_ = e1, dual2_ = e2;  // the unit axes of the triangle's own frame
+    for (int i = 0; i < 3; ++i) tri_[i] = {glm::dot(v[i] - center_, e1), glm::dot(v[i] - center_, e2)};
+    // Counter-clockwise in (e1, e2): the half-planes' tests take the inside on the left.
+    const vec2 a = tri_[1] - tri_[0], b = tri_[2] - tri_[0];
+    if (a.x * b.y - a.y * b.x < 0.0f) std::swap(tri_[1], tri_[2]);
+    int k = 0;
+    const auto at = [&](float b0, float b1, float b2) { return b0 * v[0] + b1 * v[1] + b2 * v[2]; };
+    for (int i = 0; i < 3; ++i) {
+      const float b[3] = {i == 0 ? 2.0f / 3.0f : 1.0f / 6.0f, i == 1 ? 2.0f / 3.0f : 1.0f / 6.0f,
+                          i == 2 ? 2.0f / 3.0f : 1.0f / 6.0f};
+      set(coarse_, k++, at(b[0], b[1], b[2]), 1.0f / 3.0f);
+    }
+    set(coarse_, k, center_, 0.0f);
+    struct orbit {
+      float a, b, c, w;  // barycentrics and the weight of each point
+      bool six;          // all six permutations (else the three rotations of (a, b, b))
+    };
+    constexpr orbit fine[3] = {{0.501426509658179f, 0.249286745170910f, 0.249286745170910f, 0.116786275726379f, false},
+                               {0.873821971016996f, 0.063089014491502f, 0.063089014491502f, 0.050844906370207f, false},
+                               {0.053145049844817f, 0.310352451033784f, 0.636502499121399f, 0.082851075618374f, true}};
+    k = 0;
+    for (const orbit& o : fine) {
+      set(fine_, k++, at(o.a, o.b, o.c), o.w);
+      set(fine_, k++, at(o.b, o.c, o.a), o.w);
+      set(fine_, k++, at(o.c, o.a, o.b), o.w);
+      if (o.six) {
+        set(fine_, k++, at(o.a, o.c, o.b), o.w);
+        set(fine_, k++, at(o.c, o.b, o.a), o.w);
+        set(fine_, k++, at(o.b, o.a, o.c), o.w);
+      }
+    }
+    coarse_spacing_ = nearest_neighbour_spacing(coarse_, 3);
+    fine_spacing_ = nearest_neighbour_spacing(fine_, fine_points);
   }
 
   // First-order (delta-method) v_area at the light's centre (offsets s E1 +
@@ -425,6 +501,16 @@ class planar_rule {
   }
 
   const auto_costs::shape_costs& costs() const { return costs_; }
+  // The frame the rule's table takes (auto_table.hpp): centre, the two
+  // (equivalent) edges or semi-axes, the front normal, and whether the
+  // light is symmetric about both axes (not a triangle).
+  const vec3& centre() const { return center_; }
+  const vec3& axis1() const { return E1_; }
+  const vec3& axis2() const { return E2_; }
+  const vec3& normal() const { return nl_; }
+  bool symmetric() const { return kind_ != kind::triangle; }
+  // Half of axis_i for a rectangle or a triangle, axis_i for an ellipse.
+  float half_scale() const { return kind_ == kind::ellipse ? 1.0f : 0.5f; }
   auto_choice coarse(const vec3& o, const vec3& n) const { return model(coarse_, o, n); }
 
   // Area sampling's relative variance E_A[g^2] / E_A[g]^2 - 1 at a receiver
@@ -449,7 +535,8 @@ class planar_rule {
   double peak_v_area(const vec3& o, const vec3& n, double* omega_proj = nullptr, int angles = 12) const {
     const double la = glm::length(E1_), lb = glm::length(E2_);
     const glm::dvec3 u1 = glm::dvec3(E1_) / la, u2 = glm::dvec3(E2_) / lb, nl(nl_), nd(n);
-    const double ha = rect_ ? 0.5 * la : la, hb = rect_ ? 0.5 * lb : lb;  // half-extents (semi-axes)
+    const bool rect = kind_ != kind::ellipse;  // a triangle: its equivalent rectangle's frame
+    const double ha = rect ? 0.5 * la : la, hb = rect ? 0.5 * lb : lb;  // half-extents (semi-axes)
     const glm::dvec3 q = glm::dvec3(o) - glm::dvec3(center_);
     const double h = glm::dot(q, nl);
     if (!(h > 0.0)) return 0.0;
@@ -457,7 +544,23 @@ class planar_rule {
     const double a = -glm::dot(nd, nl), nx = glm::dot(nd, u1), ny = glm::dot(nd, u2);
     // The interval [r0, r1] of rho along direction (dx, dy) inside the light.
     const auto chord = [&](double dx, double dy, double& r0, double& r1) {
-      if (rect_) {
+      if (kind_ == kind::triangle) {
+        // Three half-planes, the inside on each edge's left.
+        r0 = 0.0, r1 = std::numeric_limits<double>::infinity();
+        for (int k = 0; k < 3; ++k) {
+          const glm::dvec2 q(tri_[k]), e = glm::dvec2(tri_[(k + 1) % 3]) - q;
+          const double c0 = e.x * (fy - q.y) - e.y * (fx - q.x), cd = e.x * dy - e.y * dx;
+          if (cd == 0.0) {
+            if (c0 < 0.0) return false;
+            continue;
+          }
+          const double t = -c0 / cd;
+          if (cd > 0.0) r0 = std::max(r0, t);
+          else r1 = std::min(r1, t);
+        }
+        return r1 > r0;
+      }
+      if (rect) {
         r0 = 0.0, r1 = std::numeric_limits<double>::infinity();
         for (const auto& [f, d, e] : {std::tuple{fx, dx, ha}, std::tuple{fy, dy, hb}}) {
           if (d == 0.0) {
@@ -487,7 +590,9 @@ class planar_rule {
     // direction to its centre (the light is convex and F outside it, so
     // they span less than pi).
     double phi0 = std::atan2(ny, nx) + 0.5 * std::numbers::pi, span = 2.0 * std::numbers::pi;
-    const bool inside = rect_ ? std::abs(fx) <= ha && std::abs(fy) <= hb : (fx * fx) / (ha * ha) + (fy * fy) / (hb * hb) <= 1.0;
+    const bool inside = kind_ == kind::triangle ? inside_triangle(fx, fy)
+                        : rect ? std::abs(fx) <= ha && std::abs(fy) <= hb
+                               : (fx * fx) / (ha * ha) + (fy * fy) / (hb * hb) <= 1.0;
     if (!inside) {
       const double c = std::atan2(-fy, -fx);
       double lo = 0.0, hi = 0.0;
@@ -497,7 +602,9 @@ class planar_rule {
         if (t < -std::numbers::pi) t += 2.0 * std::numbers::pi;
         lo = std::min(lo, t), hi = std::max(hi, t);
       };
-      if (rect_) {
+      if (kind_ == kind::triangle) {
+        for (const vec2& t : tri_) extend(t.x, t.y);
+      } else if (rect) {
         for (const double sx : {-1.0, 1.0})
           for (const double sy : {-1.0, 1.0}) extend(sx * ha, sy * hb);
       } else {
@@ -562,14 +669,52 @@ class planar_rule {
   static void set(points<N>& pts, int k, const vec3& p, float w) {
     pts.x[k] = p.x, pts.y[k] = p.y, pts.z[k] = p.z, pts.w[k] = w;
   }
+  // The largest distance from one of the first `count` points to its nearest neighbour.
+  template <int N>
+  static float nearest_neighbour_spacing(const points<N>& pts, int count) {
+    float spacing = 0.0f;
+    for (int i = 0; i < count; ++i) {
+      float nearest = std::numeric_limits<float>::infinity();
+      for (int j = 0; j < count; ++j)
+        if (j != i) {
+          const vec3 d(pts.x[i] - pts.x[j], pts.y[i] - pts.y[j], pts.z[i] - pts.z[j]);
+          nearest = std::min(nearest, glm::length(d));
+        }
+      spacing = std::max(spacing, nearest);
+    }
+    return spacing;
+  }
+  // Whether (x, y) of the triangle's frame (about its centroid) lies in it.
+  bool inside_triangle(double x, double y) const {
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec2 q(tri_[k]), e = glm::dvec2(tri_[(k + 1) % 3]) - q;
+      if (e.x * (y - q.y) - e.y * (x - q.x) < 0.0) return false;
+    }
+    return true;
+  }
 
-  // The point of the plane x clamped onto the light: to the rectangle, or
-  // pulled radially into the ellipse (nearest to within its eccentricity:
-  // only the peak's size matters).
+  // The point of the plane x clamped onto the light: to the rectangle or
+  // the triangle (its nearest point), or pulled radially into the ellipse
+  // (nearest to within its eccentricity: only the peak's size matters).
   vec3 clamp_to_light(const vec3& x) const {
     const vec3 q = x - corner_;
     float s = glm::dot(q, dual1_), t = glm::dot(q, dual2_);
-    if (rect_) return corner_ + std::clamp(s, 0.0f, 1.0f) * E1_ + std::clamp(t, 0.0f, 1.0f) * E2_;
+    if (kind_ == kind::triangle) {
+      if (inside_triangle(s, t)) return corner_ + s * dual1_ + t * dual2_;
+      const vec2 f(s, t);
+      vec2 best = tri_[0];
+      float best_d2 = std::numeric_limits<float>::infinity();
+      for (int k = 0; k < 3; ++k) {
+        const vec2 a = tri_[k], e = tri_[(k + 1) % 3] - a;
+        const float ee = glm::dot(e, e);
+        const float u = ee > 0.0f ? std::clamp(glm::dot(f - a, e) / ee, 0.0f, 1.0f) : 0.0f;
+        const vec2 c = a + u * e;
+        const float d2 = glm::dot(f - c, f - c);
+        if (d2 < best_d2) best_d2 = d2, best = c;
+      }
+      return corner_ + best.x * dual1_ + best.y * dual2_;
+    }
+    if (kind_ == kind::rect) return corner_ + std::clamp(s, 0.0f, 1.0f) * E1_ + std::clamp(t, 0.0f, 1.0f) * E2_;
     const float rho2 = s * s + t * t;
     if (rho2 > 1.0f) {
       const float k = 1.0f / std::sqrt(rho2);
@@ -692,12 +837,18 @@ class planar_rule {
   float k_;
   float area_;  // the light's area
   float coarse_spacing_ = 0.0f, fine_spacing_ = 0.0f;  // largest distance between neighbouring points of each rule
-  bool rect_;
-  vec3 corner_, dual1_, dual2_;  // rect: corner and e_i / |e_i|^2; ellipse: centre and a_i / |a_i|^2
+  enum class kind : std::uint8_t { rect, ellipse, triangle };
+  kind kind_;
+  // rect: corner and e_i / |e_i|^2; ellipse: centre and a_i / |a_i|^2;
+  // triangle: centroid and its frame's unit axes (those of E1, E2).
+  vec3 corner_, dual1_, dual2_;
+  std::array<vec2, 3> tri_{};  // a triangle's vertices in that frame, counter-clockwise
   points<coarse_points> coarse_;
   points<fine_points> fine_;
   // The light's projected-solid-angle sampler, for its exact Omega_proj.
-  std::variant<rect_projected_solid_angle_sampler, ellipse_projected_solid_angle_sampler> exact_;
+  std::variant<rect_projected_solid_angle_sampler, ellipse_projected_solid_angle_sampler,
+               triangle_projected_solid_angle_sampler>
+      exact_;
 };
 
 // The visible cap (the part of the surface facing o: cos beta >= r / d at
@@ -745,6 +896,14 @@ inline light_sampling choose_strategy(const rect& r, const vec3& o, const vec3& 
 inline light_sampling choose_strategy(const ellipse& e, const vec3& o, const vec3& n, const auto_params& p = {}) {
   return planar_rule(e, auto_costs::ellipse_for(p)).choose(o, n, p);
 }
+inline auto_choice auto_model_coarse(const triangle& t, const vec3& o, const vec3& n) { return planar_rule(t).coarse(o, n); }
+inline auto_choice auto_model(const triangle& t, const vec3& o, const vec3& n) { return planar_rule(t).fine(o, n); }
+inline bool delta_v_area(const triangle& t, const vec3& o, const vec3& n, float& v) {
+  return planar_rule(t).delta_v_area(o, n, v);
+}
+inline light_sampling choose_strategy(const triangle& t, const vec3& o, const vec3& n, const auto_params& p = {}) {
+  return planar_rule(t, false, auto_costs::triangle_for(p)).choose(o, n, p);
+}
 // Spheres: a cap above the horizon whose cosine varies little is the
 // cone's without the quadrature. To first order in the cap's size v_sa =
 // tan^2(theta_c) sin^2(alpha) / 4 (cos theta = cos theta_c cos beta + sin
@@ -781,6 +940,10 @@ class tabulated_planar_rule {
                               0.5f * r.e2, r.n, p) {}
   tabulated_planar_rule(const ellipse& e, const auto_params& p)
       : tabulated_planar_rule(planar_rule(e, auto_costs::ellipse_for(p)), e.center, e.a1, e.a2, e.n, p) {}
+  // A triangle (its back side where `back`): the table in the frame of its
+  // rectangle of the same covariance, without the symmetry.
+  tabulated_planar_rule(const triangle& t, const auto_params& p, bool back)
+      : tabulated_planar_rule(planar_rule(t, back, auto_costs::triangle_for(p)), p) {}
 
   light_sampling choose(const vec3& o, const vec3& n) const { return table_.lookup(o, n); }
 
@@ -810,6 +973,10 @@ class tabulated_planar_rule {
                         const auto_params& p)
       : rule_(rule), params_(p),
         table_(c, h1, h2, nl, [rule, p](const vec3& o, const vec3& n) { return rule.choose(o, n, p); }) {}
+  tabulated_planar_rule(const planar_rule& rule, const auto_params& p)
+      : rule_(rule), params_(p),
+        table_(rule.centre(), rule.half_scale() * rule.axis1(), rule.half_scale() * rule.axis2(), rule.normal(),
+               [rule, p](const vec3& o, const vec3& n) { return rule.choose(o, n, p); }, rule.symmetric()) {}
   planar_rule rule_;
   auto_params params_;
   planar_auto_table table_;
@@ -863,9 +1030,17 @@ struct auto_sampler {
   SolidAngle solid_angle;
   Projected projected;
   auto_params params;
+  // A triangle's back side (the other half of a two-sided light; its
+  // samplers' `back`). Rectangles and ellipses carry their side in the
+  // shape, spheres have one.
+  bool back = false;
 
-  explicit auto_sampler(const Shape& s, const auto_params& p = {})
-      : shape(s), area{s}, solid_angle{s}, projected{s}, params(p), rule_(s, p) {}
+  explicit auto_sampler(const Shape& s, const auto_params& p = {}, bool back_side = false)
+      : shape(s), area(make<Area>(s, back_side)), solid_angle(make<SolidAngle>(s, back_side)),
+        projected(make<Projected>(s, back_side)), params(p), back(back_side), rule_(make_rule(s, p, back_side)) {}
+
+  // The same light with other params (its side kept).
+  auto_sampler with_params(const auto_params& p) const { return auto_sampler(shape, p, back); }
 
   bool faces(const vec3& o) const { return area.faces(o); }
 
@@ -951,7 +1126,21 @@ struct auto_sampler {
   }
 
  private:
-  typename auto_rule_of<Shape>::type rule_;
+  using rule_type = typename auto_rule_of<Shape>::type;
+  template <class T>
+  static T make(const Shape& s, bool back_side) {
+    if constexpr (std::is_same_v<Shape, triangle>)
+      return T(s, back_side);
+    else
+      return T{s};
+  }
+  static rule_type make_rule(const Shape& s, const auto_params& p, bool back_side) {
+    if constexpr (std::is_same_v<Shape, triangle>)
+      return rule_type(s, p, back_side);
+    else
+      return rule_type(s, p);
+  }
+  rule_type rule_;
 };
 
 using rect_auto_sampler =
@@ -960,5 +1149,9 @@ using ellipse_auto_sampler =
     auto_sampler<ellipse, ellipse_area_sampler, ellipse_solid_angle_sampler, ellipse_projected_solid_angle_sampler>;
 using sphere_auto_sampler =
     auto_sampler<sphere, sphere_area_sampler, sphere_cone_sampler, sphere_projected_solid_angle_sampler>;
+// Triangles: the rule per cell of a table without the symmetry; `back` for
+// the back side of a two-sided light.
+using triangle_auto_sampler = auto_sampler<triangle, triangle_area_sampler, triangle_solid_angle_sampler,
+                                           triangle_projected_solid_angle_sampler>;
 
 }  // namespace mcrt

@@ -12,11 +12,14 @@
 // true density agree as for every strategy; only where a cell straddles
 // the rule's boundary does a point get its neighbour's choice.
 //
-// Coordinates: the light and the rule are symmetric under x -> -x (with n's
-// x component) and y -> -y along its two axes, so the table holds the
-// quadrant x, y >= 0 and a receiver elsewhere is reflected into it first.
-// Lateral |x| / (|x| + s_i) in [0, 1) with s_i the light's half
-// extent along axis i (a rectangle's half edge, an ellipse's semi-axis), and
+// Coordinates: a rectangle, an ellipse and their rule are symmetric under
+// x -> -x (with n's x component) and y -> -y along its two axes, so their
+// table holds the quadrant x, y >= 0 and a receiver elsewhere is reflected
+// into it first; a triangle's table (not symmetric) holds both signs, with
+// twice the lateral cells. Lateral |x| / (|x| + s_i) in [0, 1) (x / (|x| +
+// s_i) in (-1, 1) without the symmetry) with s_i the light's half
+// extent along axis i (a rectangle's half edge, an ellipse's semi-axis, the
+// half edge of a triangle's rectangle of the same covariance), and
 // height h / (h + s_h) in [0, 1) with s_h = sqrt(s_1 s_2), so that cells are
 // fine near the light, where the choice changes, and cover every distance
 // (far receivers share the outermost cells, where the rule's choice no
@@ -87,6 +90,7 @@ class planar_auto_table {
  public:
   // Cells per coordinate: lateral (over the quadrant), height, and each of
   // the normal's two.
+  // (Without the symmetry, 2 lateral_cells over both signs.)
   static constexpr int lateral_cells = 16, height_cells = 16, normal_cells = 16;
   static constexpr std::size_t cell_count =
       std::size_t(lateral_cells) * lateral_cells * height_cells * normal_cells * normal_cells;
@@ -96,16 +100,19 @@ class planar_auto_table {
   // centre, the two half-extent vectors (orthogonal) and the unit normal of
   // the light's front; choose(o, n) the rule to tabulate (kept by the
   // table, which evaluates it at a cell's centre when a lookup first meets
-  // the cell).
+  // the cell). symmetric: the light and the rule are symmetric about both
+  // axes (header).
   template <class Rule>
-  planar_auto_table(const vec3& centre, const vec3& half1, const vec3& half2, const vec3& normal, Rule choose)
-      : c_(centre), nl_(normal) {
+  planar_auto_table(const vec3& centre, const vec3& half1, const vec3& half2, const vec3& normal, Rule choose,
+                    bool symmetric = true)
+      : c_(centre), nl_(normal), symmetric_(symmetric), lateral_(symmetric ? lateral_cells : 2 * lateral_cells),
+        position_cells_(std::size_t(lateral_) * lateral_ * height_cells) {
     s1_ = glm::length(half1);
     s2_ = glm::length(half2);
     u1_ = half1 / s1_;
     u2_ = half2 / s2_;
     sh_ = std::sqrt(s1_ * s2_);
-    cells_ = lazy_choice_cells(cell_count, [frame = *this, choose = std::move(choose)](std::size_t i) {
+    cells_ = lazy_choice_cells(position_cells_ * normal_cells * normal_cells, [frame = *this, choose = std::move(choose)](std::size_t i) {
       return choose(frame.cell_receiver(i), frame.cell_normal(i));
     });
   }
@@ -117,21 +124,23 @@ class planar_auto_table {
     const float h = glm::dot(d, nl_);
     if (!(h > 0.0f)) return light_sampling::area;
     const float x0 = glm::dot(d, u1_), y0 = glm::dot(d, u2_);
-    // Reflected into the quadrant x, y >= 0, n with it.
-    const float x = std::abs(x0), y = std::abs(y0);
-    const float nx = std::copysign(1.0f, x0) * glm::dot(n, u1_), ny = std::copysign(1.0f, y0) * glm::dot(n, u2_);
+    // Reflected into the quadrant x, y >= 0, n with it (where symmetric).
+    const float sx = symmetric_ ? std::copysign(1.0f, x0) : 1.0f, sy = symmetric_ ? std::copysign(1.0f, y0) : 1.0f;
+    const float x = sx * x0, y = sy * y0;
+    const float nx = sx * glm::dot(n, u1_), ny = sy * glm::dot(n, u2_);
     const float nz = glm::dot(n, nl_);
     // The four divisions as one packed one.
     const std::array<float, 4> inv =
-        fast_math::reciprocal4(std::abs(nx) + std::abs(ny) + std::abs(nz), x + s1_, y + s2_, h + sh_);
+        fast_math::reciprocal4(std::abs(nx) + std::abs(ny) + std::abs(nz), std::abs(x) + s1_, std::abs(y) + s2_, h + sh_);
     float a = nx * inv[0], b = ny * inv[0];
     if (nz < 0.0f) {
       const float a0 = a;
       a = std::copysign(1.0f - std::abs(b), a0);
       b = std::copysign(1.0f - std::abs(a0), b);
     }
-    const int ix = cell(x * inv[1], lateral_cells, 0.0f, 1.0f);
-    const int iy = cell(y * inv[2], lateral_cells, 0.0f, 1.0f);
+    const float lo = symmetric_ ? 0.0f : -1.0f;
+    const int ix = cell(x * inv[1], lateral_, lo, 1.0f);
+    const int iy = cell(y * inv[2], lateral_, lo, 1.0f);
     const int ih = cell(h * inv[3], height_cells, 0.0f, 1.0f);
     const int ia = cell(a, normal_cells, -1.0f, 1.0f), ib = cell(b, normal_cells, -1.0f, 1.0f);
     return cells_[index(ix, iy, ih, ia, ib)];
@@ -139,25 +148,25 @@ class planar_auto_table {
 
  private:
   // The normal's cells outermost: the receivers of one wall (one normal)
-  // meet the cells of one 4 KB block, a few pages per room (position
-  // cells: 16 x 16 x 16 bytes).
-  static constexpr std::size_t position_cells = std::size_t(lateral_cells) * lateral_cells * height_cells;
-  static std::size_t index(int ix, int iy, int ih, int a, int b) {
-    return (std::size_t(a) * normal_cells + b) * position_cells + (std::size_t(ix) * lateral_cells + iy) * height_cells + ih;
+  // meet the cells of one 4 KB block (16 KB without the symmetry), a few
+  // pages per room (position cells: 16 x 16 x 16 bytes, or 32 x 32 x 16).
+  std::size_t index(int ix, int iy, int ih, int a, int b) const {
+    return (std::size_t(a) * normal_cells + b) * position_cells_ + (std::size_t(ix) * lateral_ + iy) * height_cells + ih;
   }
   // The centre of cell i: its receiver (light's frame: the quadrant x, y >=
   // 0 in front of the light) and its unit normal.
   vec3 cell_receiver(std::size_t i) const {
-    const std::size_t position = i % position_cells;
-    const int ih = int(position % height_cells), iy = int(position / height_cells % lateral_cells),
-              ix = int(position / (std::size_t(height_cells) * lateral_cells));
-    const float x = expand(centre_of(ix, lateral_cells, 0.0f, 1.0f), s1_);
-    const float y = expand(centre_of(iy, lateral_cells, 0.0f, 1.0f), s2_);
+    const std::size_t position = i % position_cells_;
+    const int ih = int(position % height_cells), iy = int(position / height_cells % lateral_),
+              ix = int(position / (std::size_t(height_cells) * lateral_));
+    const float lo = symmetric_ ? 0.0f : -1.0f;
+    const float x = expand(centre_of(ix, lateral_, lo, 1.0f), s1_);
+    const float y = expand(centre_of(iy, lateral_, lo, 1.0f), s2_);
     const float h = expand(centre_of(ih, height_cells, 0.0f, 1.0f), sh_);
     return c_ + x * u1_ + y * u2_ + h * nl_;
   }
   vec3 cell_normal(std::size_t i) const {
-    const std::size_t normal = i / position_cells;
+    const std::size_t normal = i / position_cells_;
     const int b = int(normal % normal_cells), a = int(normal / normal_cells);
     const vec3 nloc =
         octahedral_decode(centre_of(a, normal_cells, -1.0f, 1.0f), centre_of(b, normal_cells, -1.0f, 1.0f));
@@ -179,6 +188,9 @@ class planar_auto_table {
 
   vec3 c_{0.0f}, u1_{1, 0, 0}, u2_{0, 1, 0}, nl_{0, 0, 1};
   float s1_ = 1.0f, s2_ = 1.0f, sh_ = 1.0f;
+  bool symmetric_ = true;
+  int lateral_ = lateral_cells;  // cells per lateral coordinate
+  std::size_t position_cells_ = std::size_t(lateral_cells) * lateral_cells * height_cells;
   lazy_choice_cells cells_;
 };
 
