@@ -160,6 +160,7 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
     std::vector<auto_choice> models;
     auto_light_settlement a;
     a.light = i;
+    bool screened = false;  // the rule's first test takes the cheapest strategy at every receiver
     std::visit(
         [&]<class S>(const S& s) {
           if constexpr (strategy_of<S>() == light_sampling::automatic) {
@@ -174,6 +175,10 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
             a.image_variance = p.image_variance;
             // kappa <= 1 only weighs the choice's gain down (V_l >= V): where
             // the choice does not pay with V, it is not measured.
+            if (with_cost.cheapest_at_every(noise.receivers)) {
+              screened = true;
+              return;
+            }
             models = with_cost.receiver_models(noise.receivers);
             if (!(with_cost.table_gain(noise.receivers, models) > 0.0f)) {
               rebuilt = with_cost;
@@ -207,6 +212,11 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
           }
         },
         sc.lights[i]);
+    if (screened) {
+      a.cheapest = use_cheapest(sc.lights[i]);
+      out.push_back(a);
+      continue;
+    }
     if (!rebuilt) continue;
     sc.lights[i] = std::move(*rebuilt);
     a.cheapest = use_cheapest_where_choice_does_not_pay(sc.lights[i], noise.receivers, models);

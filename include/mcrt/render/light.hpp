@@ -78,23 +78,34 @@ inline light_sampling strategy_of(const light& l) {
 // whether it did; other lights are left as they are. models: the light's
 // rule's models at rs (auto_sampler::receiver_models), where the caller
 // has them; empty, they are evaluated here.
-inline bool use_cheapest_where_choice_does_not_pay(light& l, std::span<const auto_receiver> rs,
-                                                   std::span<const auto_choice> models = {}) {
+// A light sampled by `auto` made its cheapest strategy's sampler (other
+// lights are left as they are); returns whether it was.
+inline bool use_cheapest(light& l) {
   std::optional<light> cheapest;
   std::visit(
       [&]<class S>(const S& s) {
-        if constexpr (strategy_of<S>() == light_sampling::automatic)
-          if (!((models.empty() ? s.table_gain(rs) : s.table_gain(rs, models)) > 0.0f)) {
-            if (s.cheapest() == light_sampling::area)
-              cheapest = s.area;
-            else
-              cheapest = s.solid_angle;
-          }
+        if constexpr (strategy_of<S>() == light_sampling::automatic) {
+          if (s.cheapest() == light_sampling::area)
+            cheapest = s.area;
+          else
+            cheapest = s.solid_angle;
+        }
       },
       l);
   if (!cheapest) return false;
   l = std::move(*cheapest);
   return true;
+}
+inline bool use_cheapest_where_choice_does_not_pay(light& l, std::span<const auto_receiver> rs,
+                                                   std::span<const auto_choice> models = {}) {
+  bool pays = true;
+  std::visit(
+      [&]<class S>(const S& s) {
+        if constexpr (strategy_of<S>() == light_sampling::automatic)
+          pays = (models.empty() ? s.table_gain(rs) : s.table_gain(rs, models)) > 0.0f;
+      },
+      l);
+  return !pays && use_cheapest(l);
 }
 
 // The free functions light_pdf (render/pdf.hpp) and the integrators call:

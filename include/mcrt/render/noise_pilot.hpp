@@ -91,6 +91,12 @@ namespace mcrt {
 
 struct noise_pilot_settings {
   int pixels = 1024;       // about this many pixels of the image (all, for smaller images)
+  // Each light's own noise is measured where the scene has at most this
+  // many lights (its cost grows with their number: two samples of every
+  // light at each pixel); beyond, light_variance is 0 and `auto`'s rule
+  // takes the light's share of the noise from its model alone
+  // (render/choice_gain_pilot.hpp).
+  std::size_t light_noise_limit = 256;
   int spp = 2;             // samples per pixel (>= 2: a sample variance needs two)
   int emission_rays = 8;   // K: camera rays per measured pixel, spread over the finer blocks, for the
                            // variance of what they meet first (header; < 2: none)
@@ -372,7 +378,7 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
   std::vector<int> row_counts(static_cast<std::size_t>(ny), 0), row_diffuse(static_cast<std::size_t>(ny), 0);
   std::vector<std::vector<auto_receiver>> row_receivers(static_cast<std::size_t>(ny));
   std::vector<std::vector<edge_pixel>> row_receiver_pixels(static_cast<std::size_t>(ny));
-  const std::size_t nl = sc.lights.size();
+  const std::size_t nl = sc.lights.size() <= ps.light_noise_limit ? sc.lights.size() : 0;
   std::vector<std::vector<double>> row_lights(static_cast<std::size_t>(ny), std::vector<double>(nl, 0.0));
   std::vector<std::vector<edge_pixel>> row_edges(static_cast<std::size_t>(nye + nfe));
   const double block_pixels = double(ke) * ke;  // the pixels a finer block's full weight stands for

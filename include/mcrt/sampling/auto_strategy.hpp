@@ -501,6 +501,13 @@ class planar_rule {
   }
 
   const auto_costs::shape_costs& costs() const { return costs_; }
+  // Whether the rule's first test alone (the delta method) takes area
+  // sampling at (o, n), or o is behind the light (nothing is sampled).
+  bool first_test_takes_area(const vec3& o, const vec3& n, const auto_params& p) const {
+    if (!(glm::dot(o - center_, nl_) > 0.0f)) return true;
+    float v, omega;
+    return delta_v_area(o, n, v, omega) && auto_choice::area_wins(2.0f * v, p.rest_variance_at(omega), costs_, p);
+  }
   // The frame the rule's table takes (auto_table.hpp): centre, the two
   // (equivalent) edges or semi-axes, the front normal, and whether the
   // light is symmetric about both axes (not a triangle).
@@ -959,6 +966,16 @@ class tabulated_planar_rule {
            m.score_of(choose(o, n), auto_costs::table_lookup, c, params_);
   }
   light_sampling cheapest() const { return auto_choice::cheapest(rule_.costs()); }
+  // Whether the rule's first test takes area sampling (the cheapest) at
+  // every receiver: auto_sampler::cheapest_at_every. Triangles only (the
+  // lights of meshes, often many; a rectangle's or an ellipse's gate is
+  // table_gain's alone).
+  bool cheapest_at_every(std::span<const auto_receiver> rs) const {
+    if (rule_.symmetric()) return false;
+    for (const auto_receiver& r : rs)
+      if (!rule_.first_test_takes_area(r.p, r.n, params_)) return false;
+    return true;
+  }
   // The light's own noise at the model's point with its cheapest strategy
   // (area sampling), relative to the image's: v_area / v_rest = D^2 v_area
   // / V, its share of V at the point (0 where it gives nothing).
@@ -999,6 +1016,8 @@ class tabulated_sphere_rule {
   }
   // The same above the horizon and across it.
   light_sampling cheapest() const { return auto_choice::cheapest(auto_costs::sphere_for(true, params_)); }
+  // No screen for spheres (their rule is a lookup of two numbers).
+  bool cheapest_at_every(std::span<const auto_receiver>) const { return false; }
   // As tabulated_planar_rule::noise_share, with the cone (v_sa).
   float noise_share(const auto_choice& m) const { return m.v_solid_angle() / m.rest_variance(params_); }
   float cheapest_cost() const {
@@ -1080,6 +1099,16 @@ struct auto_sampler {
     for (const auto_receiver& r : rs) models.push_back(rule_.model(r.p, r.n));
     return models;
   }
+  // Whether the rule's first, cheapest test (the delta method, a few ns)
+  // takes the cheapest strategy at every receiver in rs (or rs is behind
+  // the light): a screen before table_gain's models, which cost the fine
+  // rule per receiver. A light it passes gains nothing at rs by the rule's
+  // own first exit, and is sampled by its cheapest strategy everywhere
+  // (settle_auto_lights): in a mesh of many small emissive triangles most
+  // are, and the pilot's settling then costs a few ns per light and
+  // receiver instead of the fine rule's and the table's. Triangles only
+  // (false for rectangles, ellipses and spheres, whose gate is table_gain's).
+  bool cheapest_at_every(std::span<const auto_receiver> rs) const { return rule_.cheapest_at_every(rs); }
   // The shape's cheapest strategy (area for planar lights, the cone for
   // spheres), whose sampler is the member area or solid_angle.
   light_sampling cheapest() const { return rule_.cheapest(); }

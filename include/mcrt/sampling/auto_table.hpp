@@ -35,6 +35,9 @@
 #include <functional>
 #include <memory>
 #include <new>
+#if defined(__unix__) || defined(__APPLE__)
+#include <sys/mman.h>
+#endif
 
 #include "mcrt/core/fast_math.hpp"
 #include "mcrt/core/math.hpp"
@@ -60,7 +63,7 @@ class lazy_choice_cells {
   lazy_choice_cells(std::size_t count, fill_fn fill) : s_(std::make_shared<state>(count, std::move(fill))) {}
 
   light_sampling operator[](std::size_t i) const {
-    const std::atomic_ref<std::uint8_t> cell(s_->cells[i]);
+    const std::atomic_ref<std::uint8_t> cell(s_->bytes()[i]);
     std::uint8_t v = cell.load(std::memory_order_relaxed);
     if (v == 0) [[unlikely]] {
       v = static_cast<std::uint8_t>(1 + static_cast<int>(s_->fill(i)));
@@ -70,17 +73,49 @@ class lazy_choice_cells {
   }
 
  private:
-  struct free_bytes {
-    void operator()(std::uint8_t* p) const { std::free(p); }
-  };
   struct state {
-    // calloc: zeroed memory whose pages the system maps (zero-filled) when
-    // first touched, so a table costs the pages its met cells lie in, not
-    // the megabyte of a planar light's table.
-    state(std::size_t n, fill_fn f) : cells(static_cast<std::uint8_t*>(std::calloc(n, 1))), fill(std::move(f)) {
-      if (!cells) throw std::bad_alloc();
+    // The cells are allocated when a lookup first needs them (a light whose
+    // choice the pilot finds not to pay is never looked up: a scene of many
+    // such lights pays no table), as zeroed pages the system maps when
+    // first touched (an anonymous mapping; calloc elsewhere), so a table
+    // costs the pages its met cells lie in, not the megabyte of a planar
+    // light's table. (calloc itself zeroes a large block with memset once
+    // the C library has raised its mapping threshold after a free: with a
+    // mesh's thousands of tables that was most of the set-up's time.)
+    state(std::size_t n, fill_fn f) : count(n), fill(std::move(f)) {}
+    ~state() {
+      if (std::uint8_t* p = cells.load(std::memory_order_relaxed)) release(p, count);
     }
-    std::unique_ptr<std::uint8_t[], free_bytes> cells;  // 0: not yet evaluated
+    static std::uint8_t* zeroed(std::size_t n) {
+#if defined(__unix__) || defined(__APPLE__)
+      void* p = mmap(nullptr, n, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+      return p == MAP_FAILED ? nullptr : static_cast<std::uint8_t*>(p);
+#else
+      return static_cast<std::uint8_t*>(std::calloc(n, 1));
+#endif
+    }
+    static void release(std::uint8_t* p, std::size_t n) {
+#if defined(__unix__) || defined(__APPLE__)
+      munmap(p, n);
+#else
+      (void)n;
+      std::free(p);
+#endif
+    }
+    state(const state&) = delete;
+    state& operator=(const state&) = delete;
+    std::uint8_t* bytes() {
+      std::uint8_t* p = cells.load(std::memory_order_acquire);
+      if (p) [[likely]] return p;
+      std::uint8_t* fresh = zeroed(count);
+      if (!fresh) throw std::bad_alloc();
+      // The first thread's block stands; another's is given back.
+      if (cells.compare_exchange_strong(p, fresh, std::memory_order_acq_rel, std::memory_order_acquire)) return fresh;
+      release(fresh, count);
+      return p;
+    }
+    std::size_t count;
+    std::atomic<std::uint8_t*> cells{nullptr};  // 0 bytes: not yet evaluated
     fill_fn fill;
   };
   std::shared_ptr<state> s_;
