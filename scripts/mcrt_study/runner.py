@@ -300,7 +300,7 @@ def record_outcome(sweep: Sweep, scene: SceneInfo, point: Point, mode: str, futu
         return None
     err = McrtError(outcome["error"], outcome["returncode"], outcome["unavailable"])
     dead[(depth, config)] = str(err)
-    kind = "not available in this build, skipped" if err.unavailable else "FAILED"
+    kind = "not available in this build (for this scene), skipped" if err.unavailable else "FAILED"
     progress.message(f"{scene.name} ({mode}) {config.label}: {kind}: {err}")
     settings.failures.append(Failure(scene.name, config.strategy, str(err), err.unavailable,
                                      config.integrator, config.sampler, depth, config.light_select))
