@@ -27,8 +27,8 @@ TRI_HEIGHT = 1.0 * TRI_EDGE
 TRI_FLOOR = 400.0 * TRI_EDGE  # side of the square floor, centred under the triangle
 TRI_ALBEDO = 0.73
 # A cube (side 0.5 edge) on the floor beside the light: shadows, and light between it and the floor.
-TRI_BOX = {"centre": (2.0, -2.0), "side": 0.5}
-TRI_CAMERA = {"distance": 10.0, "elevation_deg": 45.0, "azimuth": (-1.0, -1.0), "fov": 40.0}
+TRI_BOX = {"centre": (-2.0, -2.0), "side": 0.5}
+TRI_CAMERA = {"distance": 10.0, "elevation_deg": 45.0, "azimuth": (-1.0, 1.0), "fov": 40.0}
 TRI_RESOLUTION = (600, 600)
 TRI_MAX_DEPTH = 50
 TRI_SIZE_RATIOS = [(1 / 16, "1of16"), (1 / 4, "1of4"), (1.0, "x1"), (2.0, "x2"), (4.0, "x4"), (8.0, "x8")]
@@ -63,7 +63,8 @@ def _round(points) -> list[tuple[float, float, float]]:
 
 def tri_camera() -> tuple[tuple[float, float, float], tuple[float, float, float]]:
     """The triangle families' eye and look-at point: the floor point under the light, from 10 edges
-    away, 45 degrees up, from the (-x, -z) side (the side a tilted triangle faces)."""
+    away, 45 degrees up, from the (-x, +z) side (behind a tilted triangle, which faces -z: the
+    camera sees the backs of every member's triangle, not its emission)."""
     c = TRI_CAMERA
     el = math.radians(c["elevation_deg"])
     ax, az = c["azimuth"]

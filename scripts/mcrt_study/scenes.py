@@ -123,14 +123,14 @@ def load_scenes(specs: list[str], settings: Settings) -> list[SceneInfo]:
 # tri_size, tri_distance, tri_aspect, tri_grazing: one emissive triangle (a
 #   trianglemesh with AreaLightSource "diffuse", black material: a pure emitter)
 #   over a 400x400 diffuse floor (albedo 0.73) with a cube (side 0.5, the same
-#   white) standing at (2, 0, -2) beside it; lengths in units of the reference
+#   white) standing at (-2, 0, -2) beside it; lengths in units of the reference
 #   triangle's edge: equilateral, edge 1 (area sqrt(3)/4), centroid 1 above the
 #   floor point (0, 0, 0), facing down, radiance 10. Every member's radiance is
 #   10 x sqrt(3)/4 / its area (area from the corners as written), so every
 #   member emits the reference's power. The camera (LookAt, Camera
 #   "perspective", fov 40, 600x600, box filter, maxdepth 50) looks at the floor
-#   point under the light from 10 units away, 45 degrees up, from the (-x, -z)
-#   side; it sees the backs (black) of the lights below its height.
+#   point under the light from 10 units away, 45 degrees up, from the (-x, +z)
+#   side; it sees the backs (black) of the triangles, never their emission.
 #   tri_size: the equilateral triangle at 1/16, 1/4, 1, 2, 4, 8 times the
 #     reference's area (members tri_size_1of16 ... tri_size_x8).
 #   tri_distance: the reference triangle at heights h = 0.01, 0.03, 0.1, 0.3,

@@ -131,7 +131,7 @@ class TriangleFamiliesTest(unittest.TestCase):
             n = normal(corners(m))
             with self.subTest(member=m.name):
                 self.assertAlmostEqual(-n[1], m.param, delta=2e-5)  # cos(normal, down)
-                self.assertLessEqual(n[2], 1e-12)  # towards -z, the camera's side
+                self.assertLessEqual(n[2], 1e-12)  # towards -z, away from the camera (-x, +z)
                 self.assertGreater(min(p[1] for p in corners(m)), 0.4)  # above the floor
 
     def test_solid_angles(self):
@@ -151,7 +151,7 @@ class TriangleFamiliesTest(unittest.TestCase):
     def test_scene_file(self):
         text = member_text(family_member("tri_size_x1"))
         self.assertEqual(pbrt_file_settings(text), (600, 600, 50))
-        self.assertIn('LookAt -5 7.071068 -5  0 0 0  0 1 0\nCamera "perspective" "float fov" [ 40 ]\n', text)
+        self.assertIn('LookAt -5 7.071068 5  0 0 0  0 1 0\nCamera "perspective" "float fov" [ 40 ]\n', text)
         self.assertIn('Shape "trianglemesh" "point3 P" [ -200 0 -200  200 0 -200  200 0 200  -200 0 200 ]', text)
         self.assertEqual(text.count("AreaLightSource"), 1)
         self.assertEqual(pbrt_file_settings("WorldBegin\n"), (1280, 720, 5))  # pbrt-v4's defaults
