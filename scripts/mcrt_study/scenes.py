@@ -20,7 +20,7 @@ from .solid_angles import (  # noqa: F401 (re-exported: the solid angles of ligh
     _cross, _dot, _sub, disk_solid_angle_on_axis, ellipse_solid_angle, polygon_solid_angle, sphere_solid_angle,
     triangle_solid_angle, triangles_solid_angles,
 )
-from .util import sha256_file
+from .util import bad_input, sha256_file
 
 
 def scene_path(spec: str) -> Path:
@@ -45,7 +45,7 @@ def load_scene(spec: str, settings: Settings) -> SceneInfo:
     member = family_member(spec)
     path = write_member(member, settings.out) if member is not None else scene_path(spec)
     if not path.is_file():
-        raise SystemExit(f"study.py: scene not found: {spec}")
+        raise bad_input(f"scene not found: {spec}")
     if path.suffix == ".pbrt":  # a pbrt-v4 file: its Film's resolution, its Integrator's maxdepth
         data: dict = {}
         own_width, own_height, own_depth = pbrt_file_settings(path.read_text(encoding="utf-8"))
@@ -53,14 +53,14 @@ def load_scene(spec: str, settings: Settings) -> SceneInfo:
         try:
             data = json.loads(path.read_text(encoding="utf-8"))
         except ValueError as err:
-            raise SystemExit(f"study.py: {path}: not a JSON scene file ({err})")
+            raise bad_input(f"{path}: not a JSON scene file ({err})")
         camera = data.get("camera", {})
         own_width, own_height = int(camera.get("width", 0)), int(camera.get("height", 0))
         own_depth = int(data.get("render", {}).get("max_depth", MCRT_DEFAULT_MAX_DEPTH))
     width = settings.width or int(round(own_width * DEFAULT_SCALE))
     height = settings.height or int(round(own_height * DEFAULT_SCALE))
     if width <= 0 or height <= 0:
-        raise SystemExit(f"study.py: {path}: no camera width/height; pass --width and --height")
+        raise bad_input(f"{path}: no camera width/height; pass --width and --height")
     max_depth = settings.max_depth or own_depth
     if member is not None:
         return SceneInfo(name=member.name, path=path.resolve(), content_sha256=sha256_file(path),

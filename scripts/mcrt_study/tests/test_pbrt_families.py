@@ -2,7 +2,9 @@
 counts, stable files, their resolution and depth; the light-selection axis (CLI, CSV column and
 its migration, point and reference keys, mcrt's refusals counted as unavailable)."""
 
+import contextlib
 import csv
+import io
 import importlib.util
 import math
 import os
@@ -237,6 +239,13 @@ class FilesTest(unittest.TestCase):
             [mine] = load_scenes([str(path)], settings)
             self.assertEqual((mine.name, mine.width, mine.height, mine.max_depth, mine.family), ("mine", 32, 16, 7, ""))
             self.assertIsNone(mine.light_solid_angle)
+            # Bad input: one line, exit status 2.
+            for bad in ("tri_size_x3", str(out / "missing.pbrt")):
+                with self.subTest(bad=bad), contextlib.redirect_stderr(io.StringIO()) as err, \
+                        self.assertRaises(SystemExit) as caught:
+                    load_scenes([bad], settings)
+                self.assertEqual(caught.exception.code, 2)
+                self.assertEqual(err.getvalue(), f"study.py: scene not found: {bad}\n")
 
 
 class LightSelectTest(unittest.TestCase):
