@@ -18,7 +18,8 @@ E[MSE] = var_image + var_ref, and var_ref = var_image(spp) x spp / ref_spp
 for the reference's selection; the table reports MSE - var_ref estimated
 that way, per selection (each selection's variance scales the same way).
 
-The scenes (seeded, deterministic):
+The scenes (seeded, deterministic; made by scripts/mcrt_study/many_lights_scenes.py,
+which the study's many_lights family uses too):
   lights_N: a 20 x 20 diffuse floor (albedo 0.5) with 40 diffuse boxes on
     it, and N small emitters (triangles and quads, 0.3 / sqrt(N / 10) across
     within a factor 3, at
@@ -31,129 +32,19 @@ The scenes (seeded, deterministic):
 """
 import argparse
 import json
-import math
 import os
-import random
 import subprocess
 import sys
-import time
 
 import numpy as np
 
-
-def header(res, spp, name):
-    return (
-        'LookAt 0 12 -9  0 0 0.5  0 1 0\n'
-        'Camera "perspective" "float fov" [ 45 ]\n'
-        f'Film "rgb" "integer xresolution" [ {res[0]} ] "integer yresolution" [ {res[1]} ] '
-        f'"string filename" [ "{name}.exr" ]\n'
-        'PixelFilter "box"\n'
-        f'Sampler "zsobol" "integer pixelsamples" [ {spp} ]\n'
-        'Integrator "path" "integer maxdepth" [ 3 ]\n'
-        'WorldBegin\n'
-        'Material "diffuse" "rgb reflectance" [ 0.5 0.5 0.5 ]\n'
-        'Shape "trianglemesh" "point3 P" [ -10 0 -10  10 0 -10  10 0 10  -10 0 10 ] '
-        '"integer indices" [ 0 1 2  0 2 3 ]\n')
-
-
-def boxes(rng):
-    out = []
-    for _ in range(40):
-        cx, cz = rng.uniform(-8, 8), rng.uniform(-8, 8)
-        sx, sy, sz = rng.uniform(0.2, 1.0), rng.uniform(0.2, 1.5), rng.uniform(0.2, 1.0)
-        p = [(cx + dx * sx, dy * sy, cz + dz * sz) for dx in (-0.5, 0.5) for dy in (0, 1) for dz in (-0.5, 0.5)]
-        # Vertex index = 4 ix + 2 iy + iz; the 12 triangles of the 6 faces.
-        idx = [0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1, 2, 3, 7, 2, 7, 6, 0, 2, 6, 0, 6, 4, 1, 5, 7, 1, 7, 3]
-        pts = ' '.join(f'{x:.5f} {y:.5f} {z:.5f}' for x, y, z in p)
-        out.append(f'Shape "trianglemesh" "point3 P" [ {pts} ] "integer indices" [ {" ".join(map(str, idx))} ]\n')
-    return ''.join(out)
-
-
-def small_lights(rng, n, spread=9.0):
-    out = []
-    for _ in range(n):
-        c = (rng.uniform(-spread, spread), rng.uniform(0.05, 3.0), rng.uniform(-spread, spread))
-        # Sizes shrink as 1 / sqrt(N): the lights' total area (and power)
-        # is the same for every N, and the camera sees few of them.
-        size = rng.uniform(0.5, 1.5) * 0.3 / math.sqrt(max(n, 10) / 10)
-        # A normal within 32 degrees of straight down: the camera above sees
-        # only the lights' backs, so that the image's error is the floor's
-        # (the light selections'), not the pixels' coverage of bright
-        # emitters.
-        z = -rng.uniform(0.85, 1.0)
-        phi = rng.uniform(0, 2 * math.pi)
-        r = math.sqrt(1 - z * z)
-        nrm = np.array([r * math.cos(phi), z, r * math.sin(phi)])
-        t = np.cross(nrm, [0.3, 0.1, 0.9])
-        t /= np.linalg.norm(t)
-        b = np.cross(nrm, t)
-        L = 10 ** rng.uniform(-1, 2)
-        if rng.random() < 0.5:
-            pts = [np.array(c) + size * (math.cos(a) * t + math.sin(a) * b) for a in (0.0, 2.1, 4.2)]
-            idx = '0 1 2'
-        else:
-            pts = [np.array(c) + size * (sx * t + sy * b) for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
-            idx = '0 1 2  0 2 3'
-        # The winding makes the geometric normal cross(p1 - p0, p2 - p0) = b x t... orient it towards nrm.
-        e = np.cross(pts[1] - pts[0], pts[2] - pts[0])
-        flip = 'ReverseOrientation\n' if np.dot(e, nrm) < 0 else ''
-        ps = ' '.join(f'{v:.6f}' for p in pts for v in p)
-        out.append('AttributeBegin\n' + flip +
-                   f'AreaLightSource "diffuse" "rgb L" [ {L:.5f} {L:.5f} {L:.5f} ]\n'
-                   'Material "diffuse" "rgb reflectance" [ 0 0 0 ]\n'
-                   f'Shape "trianglemesh" "point3 P" [ {ps} ] "integer indices" [ {idx} ]\nAttributeEnd\n')
-    return ''.join(out)
-
-
-def mesh_light(rng, k=80):
-    # A wavy curtain at x ~ -9 (y from 0.2 to 4, z over [-9, 9]) emitting
-    # towards +x, in 8 strips of different radiance: 2 x 80 x 80 triangles.
-    out = []
-    strips = 8
-    for s in range(strips):
-        L = 10 ** rng.uniform(-0.5, 1.0)
-        z0 = -9 + 18 * s / strips
-        rows = k // strips
-        pts, idx = [], []
-        for j in range(rows + 1):
-            for i in range(k + 1):
-                y = 0.2 + 3.8 * i / k
-                z = z0 + (18 / strips) * j / rows
-                x = -9 + 0.5 * math.sin(1.3 * y) * math.cos(0.9 * z)
-                pts.append((x, y, z))
-        for j in range(rows):
-            for i in range(k):
-                a = j * (k + 1) + i
-                b, c, d = a + 1, a + k + 1, a + k + 2
-                idx += [a, b, c, b, d, c]  # normal +x
-        ps = ' '.join(f'{x:.5f} {y:.5f} {z:.5f}' for x, y, z in pts)
-        out.append('AttributeBegin\n'
-                   f'AreaLightSource "diffuse" "rgb L" [ {L:.4f} {L:.4f} {L:.4f} ]\n'
-                   'Material "diffuse" "rgb reflectance" [ 0 0 0 ]\n'
-                   f'Shape "trianglemesh" "point3 P" [ {ps} ] "integer indices" [ {" ".join(map(str, idx))} ]\n'
-                   'AttributeEnd\n')
-    return ''.join(out)
-
-
-def write_scenes(outdir, res=(160, 120)):
-    os.makedirs(outdir, exist_ok=True)
-    names = []
-    for n in (10, 100, 1000, 10000, 100000):
-        rng = random.Random(1000 + n)
-        name = f'lights_{n}'
-        with open(os.path.join(outdir, name + '.pbrt'), 'w') as f:
-            f.write(header(res, 16, name) + boxes(rng) + small_lights(rng, n))
-        names.append(name)
-    rng = random.Random(77)
-    with open(os.path.join(outdir, 'mesh_light.pbrt'), 'w') as f:
-        f.write(header(res, 16, 'mesh_light') + boxes(rng) + mesh_light(rng) + small_lights(rng, 20))
-    names.append('mesh_light')
-    return names
+# The scenes' generator is the study package's (the study's many_lights family renders them too).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'scripts'))
+from mcrt_study.many_lights_scenes import write_scenes  # noqa: E402
 
 
 def read_exr(path):
     # The study package's reader (mcrt's EXR files: float RGB, ZIP).
-    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'scripts'))
     from mcrt_study.exr import read_rgb  # noqa: PLC0415
     return np.asarray(read_rgb(path), dtype=np.float64)
 

@@ -4,7 +4,8 @@ Runs the whole study with one command: for every Cornell scene, every
 configuration of the renderer — light-sampling strategy (``area``,
 ``solid-angle``) × integrator (``mixture``: Shirley's mixture pdf, ``nee``:
 next-event estimation, ``mis``: NEE with multiple importance sampling) ×
-sample generator (``independent``, ``stratified``, ``sobol``) — and both
+sample generator (``independent``, ``stratified``, ``sobol``) × light
+selection (``--light-selects``; by default the scene's own) — and both
 light-transport modes (``global``: the scene's max depth; ``direct``: max
 depth 1), it renders a sweep of sample counts with several seeds, measures the
 render time (``render_seconds`` from ``mcrt render --stats``: the rendering
@@ -21,10 +22,21 @@ scripts/setup.sh)::
     .venv/bin/python scripts/study.py --out bench/results --overwrite-committed
                                                       # rewrite the committed report
 
-    # your own scene file (a path; a name without .json is looked up in scenes/)
+    # your own scene file (a path, .json or .pbrt; a name without an extension is
+    # looked up as scenes/NAME.json)
     .venv/bin/python scripts/study.py --scenes path/to/my_scene.json \
         --integrators nee --samplers sobol \
         --strategies area solid-angle projected-solid-angle auto
+
+    # the triangle families, with pbrt-v4's strategy as the anchor
+    .venv/bin/python scripts/study.py --scenes tri_size tri_distance tri_aspect tri_grazing \
+        --integrators nee --samplers sobol --strategies area solid-angle \
+        projected-solid-angle bilinear-solid-angle pbrt auto
+
+    # many lights: the light selections against each other
+    .venv/bin/python scripts/study.py --scenes many_lights --integrators nee \
+        --samplers sobol --strategies area solid-angle \
+        --light-selects power uniform bvh pbrt-bvh --ref-light-select bvh
 
     # choose what to run: every axis has its option
     .venv/bin/python scripts/study.py --scenes cornell_rect cornell_disk \\
@@ -66,9 +78,23 @@ size_sphere (the Cornell box with its ceiling light a rectangle, disk or
 sphere at 1/16, 1/4, 1, 2, 4, 8 times the seed light's area, equal radiance
 times (projected) area; members size_rect_1of16 ... size_rect_x8) and distance
 (the seed's rectangle over a large floor at heights 0.01 ... 10 times its size;
-members distance_h0.01 ... distance_h10). Their scene files are written to
-OUT/scenes/ when the study runs, byte-identical from run to run, so they are
-cached like scene files. See scenes.py for their exact geometry.
+members distance_h0.01 ... distance_h10). The triangle families are pbrt-v4
+files (the JSON format has no triangles): one emissive triangle over a large
+floor beside a small cube, of equal power in every member: tri_size (the
+equilateral triangle at 1/16 ... 8 times the reference's area; members
+tri_size_1of16 ... tri_size_x8), tri_distance (heights 0.01 ... 10 times its
+edge; tri_distance_h0.01 ... tri_distance_h10), tri_aspect (slivers of the
+same area, base / height 1 ... 10^4 times the equilateral's; tri_aspect_a1 ...
+tri_aspect_a10000) and tri_grazing (tilted until the cosine between its normal
+and straight down is 1 ... 0.001, its plane nearly through the floor under it;
+tri_grazing_c1 ... tri_grazing_c0.001). many_lights: the scenes of
+bench/many_lights.py (N = 10 ... 10^5 small emitters of varied radiance over a
+floor with boxes, many_lights_n10 ... many_lights_n100000, and an emissive
+mesh of 12,800 triangles, many_lights_mesh), scaled to the same power. Their
+scene files are written to OUT/scenes/ (NAME.json or NAME.pbrt) when the study
+runs, byte-identical from run to run, so they are cached like scene files
+(the files of 10^4 and 10^5 lights take seconds to make). See scenes.py for
+their exact geometry.
 With a family among the scenes the report plots, per family and depth mode,
 each strategy's efficiency over area sampling against the light's solid
 angle and tabulates where it crosses 1 (family_<family>_<mode>.png).
@@ -101,8 +127,9 @@ are dropped and run again. ``--fresh`` discards all previous points
 (references stay cached). A results.csv of the earlier format
 (scene,strategy,spp,seed,seconds,rmse,mse,relmse) is read as integrator
 mixture, sampler independent and the scene's max depth (how it was made) and
-rewritten in the new format, as is one without the family columns; a study_state.json of the earlier version is
-carried over likewise.
+rewritten in the new format, as is one without the family columns or without
+the light_select column (read as light selection default); a study_state.json
+of the earlier version is carried over likewise.
 
 Sweep order. For every seed and spp, every depth mode and configuration is
 rendered in turn (the order of the configurations rotated from one point to
@@ -120,9 +147,20 @@ order whatever order the points finish in. Concurrent renders share the
 machine; equal-time comparisons stay fair because the configurations are
 rotated, so that each runs alongside the others alike.
 
+Light selection. ``--light-selects`` adds mcrt's ``--light-select`` (how
+next-event estimation chooses among several lights: power, uniform, bvh,
+pbrt-bvh) as an axis of the configurations; ``default`` (the default) passes
+none, so that the scene chooses (a pbrt-v4 file's lightsampler, else power).
+It is a column of the CSV and of the report's tables (when the run names a
+selection), part of a point's key, and the baseline takes the default
+selection (or the first selected). ``--ref-light-select`` chooses the
+references' (enters their cache key when it is not the default; bvh makes less
+noisy references of many lights).
+
 Unavailable strategies. A configuration that mcrt rejects as "not available
-in this build" (exit status 2) is skipped for that scene and named in the
-report; the study goes on, and picks it up unchanged once mcrt supports it (a
+in this build", or as not available for that kind of scene file (exit status
+2; for now ``--light-sampling auto`` on pbrt-v4 scenes), is skipped for that
+scene and named in the report; the study goes on, and picks it up unchanged once mcrt supports it (a
 reference that fell back to area sampling is then rendered again with
 solid-angle sampling, and the points of its scene and depth with it). Any
 other mcrt failure is reported too and makes the exit status 1.
@@ -147,12 +185,16 @@ the first selected integrator, sampler and mode when those are not run).
 Outputs (in OUT):
     results.csv          scene,strategy,integrator,sampler,max_depth,spp,seed,
                          seconds,rmse,mse,relmse,family,family_param,
-                         light_solid_angle (max_depth: the value passed
-                         to mcrt, 1 in the direct mode; family and
+                         light_solid_angle,light_select (max_depth: the value
+                         passed to mcrt, 1 in the direct mode; family and
                          family_param empty for scene files; the solid angle
                          (sr) of the scene's first light from the box's centre
-                         (278, 278, 279.5), or for the distance family from the
-                         floor point under the light, empty when not computed)
+                         (278, 278, 279.5), for the distance and triangle
+                         families from the floor point under the light, for
+                         many_lights the median over its emitting triangles
+                         from the floor point (0, 0, 0.5), empty when not
+                         computed, as for pbrt-v4 files of one's own;
+                         light_select: default when no --light-select was passed)
     tables.md            the markdown tables
     README.md            the report: machine, the renderer's commit and the
                          mcrt binary's sha256, command line, date, tables,
@@ -176,7 +218,11 @@ Code (this package; scripts/study.py is the command's entry point and calls
 cli.main):
     config.py       constants, the types (Config, SceneInfo, Settings, ...),
                     the command line and its defaults
-    scenes.py       scene files by name or path; generated families; solid angles
+    scenes.py       scene files by name or path; generated families
+    pbrt_families.py  the pbrt-v4 families (triangles, many lights); a pbrt-v4
+                    file's resolution and depth
+    many_lights_scenes.py  the many-light scenes (bench/many_lights.py's too)
+    solid_angles.py the solid angles of lights
     mcrt.py         running mcrt: render (with its time), diff
     references.py   reference images and their cache keys
     results.py      results.csv and study_state.json (resuming)

@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 from .config import (
-    BASELINE, Config, LEGACY_INTEGRATOR, LEGACY_SAMPLER, SceneInfo, Settings, config_of,
+    BASELINE, DEFAULT_LIGHT_SELECT, Config, LEGACY_INTEGRATOR, LEGACY_SAMPLER, SceneInfo, Settings, config_of,
 )
 
 
@@ -31,10 +32,10 @@ def pick(axis: list[str], preferred: str) -> str:
 
 
 def baseline_config(settings: Settings) -> Config:
-    """The configuration the others are compared with: area, mixture, independent (or the first
-    selected value of an axis that lacks it)."""
+    """The configuration the others are compared with: area, mixture, independent, the default
+    light selection (or the first selected value of an axis that lacks it)."""
     return Config(pick(settings.strategies, BASELINE.strategy), pick(settings.integrators, BASELINE.integrator),
-                  pick(settings.samplers, BASELINE.sampler))
+                  pick(settings.samplers, BASELINE.sampler), pick(settings.light_selects, BASELINE.light_select))
 
 
 def slice_of(settings: Settings) -> tuple[str, str, str]:
@@ -46,11 +47,13 @@ def slice_of(settings: Settings) -> tuple[str, str, str]:
 
 
 def slice_rows(rows: list[dict], settings: Settings, scenes: list[SceneInfo]) -> list[dict]:
-    """The rows of the earlier study's slice (see slice_of)."""
+    """The rows of the earlier study's slice (see slice_of), with the baseline's light selection."""
     integrator, sampler, mode = slice_of(settings)
     depth = {sc.name: sc.depth(mode) for sc in scenes}
+    select = baseline_config(settings).light_select
     return [r for r in rows if r["integrator"] == integrator and r["sampler"] == sampler
-            and r["max_depth"] == depth.get(r["scene"])]
+            and r["max_depth"] == depth.get(r["scene"])
+            and (r.get("light_select") or DEFAULT_LIGHT_SELECT) == select]
 
 
 def group_stats(rows: list[dict], **match):
@@ -58,9 +61,13 @@ def group_stats(rows: list[dict], **match):
     mse, relmse (numpy), sorted by spp."""
     import numpy as np
 
+    def field(r: dict, k: str):
+        # Rows made before the light selection was recorded have the default one.
+        return (r.get(k) or DEFAULT_LIGHT_SELECT) if k == "light_select" else r[k]
+
     by_spp: dict[int, list[dict]] = {}
     for r in rows:
-        if all(r[k] == v for k, v in match.items()):
+        if all(field(r, k) == v for k, v in match.items()):
             by_spp.setdefault(r["spp"], []).append(r)
     spps = sorted(by_spp)
     return {
@@ -153,7 +160,8 @@ def analyse_configs(rows: list[dict], settings: Settings,
         per: dict[Config, dict] = {}
         for config in settings.configs:
             st = group_stats(rows, scene=scene, max_depth=depth, strategy=config.strategy,
-                             integrator=config.integrator, sampler=config.sampler)
+                             integrator=config.integrator, sampler=config.sampler,
+                             light_select=config.light_select)
             if not len(st["spp"]):
                 continue
             per[config] = {
@@ -214,7 +222,10 @@ def crossovers(x, ratio) -> list[float]:
 # --------------------------------------------------------------------------
 
 FAMILY_PARAM_LABELS = {"size_rect": "light area / seed's", "size_disk": "light area / seed's",
-                       "size_sphere": "projected area / seed's", "distance": "h / light size"}
+                       "size_sphere": "projected area / seed's", "distance": "h / light size",
+                       "tri_size": "triangle area / reference's", "tri_distance": "h / triangle edge",
+                       "tri_aspect": "aspect (base / height vs equilateral)",
+                       "tri_grazing": "cos(normal, down)", "many_lights": "emitters"}
 
 
 def family_param_label(family: str) -> str:
@@ -294,9 +305,10 @@ def interp_param(solid_angle: float, solid_angles, params) -> float:
 
 
 def family_crossovers(analysis: dict, settings: Settings, scenes: list[SceneInfo]) -> list[dict]:
-    """Per family of the run, depth mode, integrator, sampler and strategy other than area (area
-    of the same integrator and sampler the baseline): its series (family_series), crossings of 1
-    in solid angle with the family parameter there, and the verdict (crossover_verdict).
+    """Per family of the run, depth mode, integrator, sampler, light selection and strategy other
+    than area (area of the same integrator, sampler and light selection the baseline): its series
+    (family_series), crossings of 1 in solid angle with the family parameter there, and the
+    verdict (crossover_verdict).
 
     Empty when area sampling is not among the strategies.
     """
@@ -305,18 +317,18 @@ def family_crossovers(analysis: dict, settings: Settings, scenes: list[SceneInfo
     found = []
     for family, members in run_families(scenes).items():
         for mode in settings.depths:
-            for integrator in settings.integrators:
-                for sampler in settings.samplers:
-                    base = Config("area", integrator, sampler)
-                    for strategy in settings.strategies:
-                        if strategy == "area":
-                            continue
-                        series = family_series(analysis, members, mode, base, Config(strategy, integrator, sampler))
-                        crossings, verdict = crossover_verdict(series["solid_angle"], series["ratio"])
-                        found.append({
-                            "family": family, "mode": mode, "integrator": integrator, "sampler": sampler,
-                            "strategy": strategy, "series": series, "crossings": crossings,
-                            "params": [interp_param(c, series["solid_angle"], series["param"]) for c in crossings],
-                            "verdict": verdict,
-                        })
+            for integrator, sampler, select in itertools.product(settings.integrators, settings.samplers,
+                                                                 settings.light_selects):
+                base = Config("area", integrator, sampler, select)
+                for strategy in settings.strategies:
+                    if strategy == "area":
+                        continue
+                    series = family_series(analysis, members, mode, base, Config(strategy, integrator, sampler, select))
+                    crossings, verdict = crossover_verdict(series["solid_angle"], series["ratio"])
+                    found.append({
+                        "family": family, "mode": mode, "integrator": integrator, "sampler": sampler,
+                        "light_select": select, "strategy": strategy, "series": series, "crossings": crossings,
+                        "params": [interp_param(c, series["solid_angle"], series["param"]) for c in crossings],
+                        "verdict": verdict,
+                    })
     return found

@@ -7,7 +7,7 @@ import math
 
 from .analysis import scene_panels
 from .config import (
-    COMMON_PLOTS, CSV_COLUMNS, Config, REPORT_MD, RESULTS_CSV, SceneInfo, Settings, TABLES_MD,
+    COMMON_PLOTS, CSV_COLUMNS, REPORT_MD, RESULTS_CSV, SceneInfo, Settings, TABLES_MD,
     config_of,
 )
 from .report import panel_title
@@ -54,7 +54,7 @@ def run_checks(settings: Settings, rows: list[dict], scenes: list[SceneInfo], su
           "no mcrt failure other than 'not available in this build'")
     finite = all(math.isfinite(r[k]) and r[k] >= 0 for r in rows for k in ("rmse", "mse", "relmse"))
     check(finite and all(r["seconds"] > 0 for r in rows), "errors finite and non-negative, times positive")
-    unavailable = {(f.scene, Config(f.strategy, f.integrator, f.sampler), f.max_depth)
+    unavailable = {(f.scene, f.config, f.max_depth)
                    for f in settings.failures if f.unavailable}
     expected = len(settings.spp) * len(settings.seeds)
     for scene, mode, depth in panels:

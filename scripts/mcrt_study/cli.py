@@ -11,7 +11,7 @@ import time
 from .analysis import scene_panels, select_rows, slice_rows
 from .check import run_checks
 from .config import (
-    Config, Failure, REPORT_MD, RESULTS_CSV, STATE_JSON, SceneInfo, Settings, build_parser,
+    Failure, REPORT_MD, RESULTS_CSV, STATE_JSON, SceneInfo, Settings, build_parser,
     make_new_output_dir, output_refusal, resolve_settings,
 )
 from .executors import add_arguments, backend_of
@@ -49,7 +49,7 @@ def report_only_inputs(settings: Settings, scenes: list[SceneInfo], spp_given: b
     configs = set(settings.configs)
     failures = [Failure(**f) for f in state.get("failures", [])]
     settings.failures = [f for f in failures if f.scene in names
-                         and Config(f.strategy, f.integrator, f.sampler) in configs
+                         and f.config in configs
                          and (f.max_depth is None or f.max_depth in depths[f.scene])]
     return rows
 

@@ -11,6 +11,7 @@ import subprocess
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable
 
 
 # This file is scripts/mcrt_study/config.py.
@@ -18,17 +19,25 @@ REPO_ROOT = Path(__file__).resolve().parent.parent.parent
 SCENES_DIR = REPO_ROOT / "scenes"
 
 CSV_COLUMNS = ["scene", "strategy", "integrator", "sampler", "max_depth", "spp", "seed",
-               "seconds", "rmse", "mse", "relmse", "family", "family_param", "light_solid_angle"]
+               "seconds", "rmse", "mse", "relmse", "family", "family_param", "light_solid_angle",
+               "light_select"]
+# The CSV before the light-selection column (every row: DEFAULT_LIGHT_SELECT): read, then
+# rewritten as CSV_COLUMNS.
+PRE_SELECT_CSV_COLUMNS = CSV_COLUMNS[:14]
 # The CSV before the scene-family columns: read, then rewritten as CSV_COLUMNS.
 PRE_FAMILY_CSV_COLUMNS = CSV_COLUMNS[:11]
 # The CSV of the earlier, single-integrator study: read, then rewritten as CSV_COLUMNS.
 OLD_CSV_COLUMNS = ["scene", "strategy", "spp", "seed", "seconds", "rmse", "mse", "relmse"]
-STRATEGIES = ["area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle", "auto"]
+STRATEGIES = ["area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle", "pbrt", "auto"]
 # The default sweep (the committed report); the others by --strategies.
 DEFAULT_STRATEGIES = ["area", "solid-angle"]
 # References with --ref-strategy preferred: the first this mcrt has for the scene.
 REF_STRATEGY_PREFERENCE = ["solid-angle", "area"]
 INTEGRATORS = ["mixture", "nee", "mis"]
+# How next-event estimation chooses among a scene's lights (mcrt's --light-select); "default"
+# passes no --light-select: the scene's own (a pbrt-v4 file's lightsampler, else power).
+DEFAULT_LIGHT_SELECT = "default"
+LIGHT_SELECTS = [DEFAULT_LIGHT_SELECT, "power", "uniform", "bvh", "pbrt-bvh"]
 SAMPLERS = ["independent", "stratified", "sobol"]
 DEPTH_MODES = ["global", "direct"]
 DIRECT_MAX_DEPTH = 1
@@ -80,6 +89,7 @@ STRATEGY_STYLE = {
     "solid-angle": {"color": "tab:orange", "label": "solid angle"},
     "projected-solid-angle": {"color": "tab:green", "label": "projected solid angle"},
     "bilinear-solid-angle": {"color": "tab:purple", "label": "bilinear solid angle"},
+    "pbrt": {"color": "tab:brown", "label": "pbrt-v4's choice"},
     "auto": {"color": "tab:red", "label": "auto (per shading point)"},
 }
 
@@ -94,6 +104,9 @@ SAMPLER_DESCRIPTIONS = {
 }
 
 NOT_AVAILABLE_MARKER = "not available in this build"
+# What mcrt says (exit status 2) for a strategy it lacks: in this build, or for a kind of scene
+# file (--light-sampling auto on a pbrt-v4 scene where auto has no rule for its lights).
+NOT_AVAILABLE_MARKERS = (NOT_AVAILABLE_MARKER, "not available for pbrt-v4 scenes")
 
 # For the progress bar's estimate only: the fixed cost of one mcrt process
 # (start, scene set-up, image input/output), counted as this many samples of
@@ -101,22 +114,26 @@ NOT_AVAILABLE_MARKER = "not available in this build"
 PROCESS_OVERHEAD_SAMPLES = 1_000_000
 INTEGRATOR_COST = {"mixture": 1.0, "nee": 1.8, "mis": 1.8}
 STRATEGY_COST = {"area": 1.0, "solid-angle": 1.9, "projected-solid-angle": 2.5, "bilinear-solid-angle": 2.2,
-                 "auto": 1.5}
+                 "pbrt": 2.0, "auto": 1.5}
 DIRECT_COST = 0.55
 
 
 @dataclass(frozen=True)
 class Config:
-    """One configuration of the renderer: light-sampling strategy, integrator, sample generator."""
+    """One configuration of the renderer: light-sampling strategy, integrator, sample generator,
+    light selection."""
 
     strategy: str
     integrator: str
     sampler: str
+    light_select: str = DEFAULT_LIGHT_SELECT
 
     @property
     def label(self) -> str:
-        """Short name for logs and file names: integrator/sampler/strategy."""
-        return f"{self.integrator}/{self.sampler}/{self.strategy}"
+        """Short name for logs and file names: integrator/sampler/strategy, then /light selection
+        unless it is the default."""
+        tail = "" if self.light_select == DEFAULT_LIGHT_SELECT else f"/{self.light_select}"
+        return f"{self.integrator}/{self.sampler}/{self.strategy}{tail}"
 
 
 # The configuration every other is compared with: the earlier study's area sampling.
@@ -125,7 +142,8 @@ BASELINE = Config("area", LEGACY_INTEGRATOR, LEGACY_SAMPLER)
 
 def config_of(row: dict) -> Config:
     """The configuration a CSV row was rendered with."""
-    return Config(row["strategy"], row["integrator"], row["sampler"])
+    return Config(row["strategy"], row["integrator"], row["sampler"],
+                  row.get("light_select") or DEFAULT_LIGHT_SELECT)
 
 
 @dataclass(frozen=True)
@@ -159,6 +177,33 @@ class SceneInfo:
         return pairs
 
 
+@dataclass(frozen=True)
+class FamilyMember:
+    """One generated scene (scenes.FAMILIES): its name, family, family parameter, scene and the
+    light solid angle (sr) the CSV reports.
+
+    `scene` is a JSON scene's data (a dict), a pbrt-v4 file's text, or a function that makes that
+    text; `light_solid_angle` a number or a function that computes it (members that take a while
+    to make are made when first asked for, once per process)."""
+
+    name: str
+    family: str
+    param: float
+    scene: dict | str | Callable[[], str]
+    light_solid_angle: float | Callable[[], float]
+
+    @property
+    def suffix(self) -> str:
+        """The extension of the member's file: .json or .pbrt."""
+        return ".json" if isinstance(self.scene, dict) else ".pbrt"
+
+    @property
+    def solid_angle(self) -> float:
+        """The light solid angle (sr)."""
+        value = self.light_solid_angle
+        return float(value()) if callable(value) else float(value)
+
+
 @dataclass
 class Reference:
     """A cached reference image and how it was made."""
@@ -175,6 +220,7 @@ class Reference:
     seed: int
     seconds: float
     cached: bool
+    light_select: str = DEFAULT_LIGHT_SELECT
 
 
 @dataclass
@@ -188,6 +234,12 @@ class Failure:
     integrator: str = LEGACY_INTEGRATOR
     sampler: str = LEGACY_SAMPLER
     max_depth: int | None = None  # None: every depth (failures recorded by the earlier study)
+    light_select: str = DEFAULT_LIGHT_SELECT
+
+    @property
+    def config(self) -> Config:
+        """The configuration that failed."""
+        return Config(self.strategy, self.integrator, self.sampler, self.light_select)
 
 
 @dataclass
@@ -232,12 +284,21 @@ class Settings:
     time_repeats: int = 1
     # True when `out` is the new directory chosen without --out (resuming needs --out naming it).
     out_is_new: bool = False
+    # Light selections of the sweep (--light-selects) and of the references (--ref-light-select).
+    light_selects: list[str] = field(default_factory=lambda: [DEFAULT_LIGHT_SELECT])
+    ref_light_select: str = DEFAULT_LIGHT_SELECT
 
     @property
     def configs(self) -> list[Config]:
-        """Every selected configuration, in table order (strategies of one integrator and sampler adjacent)."""
-        axes = itertools.product(self.integrators, self.samplers, self.strategies)
-        return [Config(s, i, m) for i, m, s in axes]
+        """Every selected configuration, in table order (strategies of one integrator, sampler and
+        light selection adjacent)."""
+        axes = itertools.product(self.integrators, self.samplers, self.light_selects, self.strategies)
+        return [Config(s, i, m, ls) for i, m, ls, s in axes]
+
+    @property
+    def varies_light_select(self) -> bool:
+        """Whether the run names a light selection (the tables then have a column for it)."""
+        return self.light_selects != [DEFAULT_LIGHT_SELECT]
 
 
 def parse_int_list(tokens: list[str]) -> list[int]:
@@ -292,9 +353,11 @@ def build_parser() -> argparse.ArgumentParser:
                    "results, e.g. --out bench/results/strategy_map), whose files the run rewrites; "
                    "without it such a directory is refused (exit status 2)")
     p.add_argument("--scenes", nargs="+", default=None,
-                   help="scene names in scenes/, paths to scene files, generated families "
-                   "(size_rect, size_disk, size_sphere, distance: all their members) or members "
-                   f"(e.g. size_rect_x2, distance_h0.01) (default: {' '.join(DEFAULT_SCENES)})")
+                   help="scene names in scenes/, paths to scene files (.json or .pbrt), generated "
+                   "families (size_rect, size_disk, size_sphere, distance, tri_size, tri_distance, "
+                   "tri_aspect, tri_grazing, many_lights: all their members) or members "
+                   "(e.g. size_rect_x2, distance_h0.01, tri_aspect_a1000, many_lights_n1000) "
+                   f"(default: {' '.join(DEFAULT_SCENES)})")
     p.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=None,
                    help="light-sampling strategies (default: area solid-angle; --quick: "
                    f"{' '.join(QUICK_STRATEGIES)})")
@@ -304,6 +367,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--samplers", nargs="+", choices=SAMPLERS, default=None,
                    help="sample generators (default: all three; --quick: "
                    f"{' '.join(QUICK_SAMPLERS)})")
+    p.add_argument("--light-selects", nargs="+", choices=LIGHT_SELECTS, default=None,
+                   help="light selections (mcrt's --light-select: how next-event estimation chooses "
+                   "among several lights); default: the scene's own, no --light-select passed "
+                   "(a pbrt-v4 file's lightsampler, else power) (default: default)")
     p.add_argument("--depths", nargs="+", choices=DEPTH_MODES, default=None,
                    help="light-transport modes: global (the scene's max depth, or --max-depth) "
                    f"and direct (max depth {DIRECT_MAX_DEPTH}: direct lighting only) (default: both)")
@@ -322,6 +389,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"integrator of the references (default: {DEFAULT_REF_INTEGRATOR})")
     p.add_argument("--ref-sampler", choices=SAMPLERS, default=DEFAULT_REF_SAMPLER,
                    help=f"sample generator of the references (default: {DEFAULT_REF_SAMPLER})")
+    p.add_argument("--ref-light-select", choices=LIGHT_SELECTS, default=DEFAULT_LIGHT_SELECT,
+                   help="light selection of the references (default: the scene's own; bvh gives "
+                   "less noisy references of scenes with many lights)")
     p.add_argument("--ref-key-binary", action="store_true",
                    help="include a hash of the mcrt binary in the reference cache key")
     p.add_argument("--width", type=int, default=None,
@@ -402,6 +472,8 @@ def resolve_settings(args: argparse.Namespace, argv: list[str]) -> Settings:
     settings.integrators = [s for s in INTEGRATORS if s in settings.integrators]
     settings.samplers = [s for s in SAMPLERS if s in settings.samplers]
     settings.depths = [s for s in DEPTH_MODES if s in settings.depths]
+    settings.light_selects = [s for s in LIGHT_SELECTS if s in (args.light_selects or [DEFAULT_LIGHT_SELECT])]
+    settings.ref_light_select = args.ref_light_select
     settings.spp = sorted(set(settings.spp))
     settings.seeds = list(dict.fromkeys(settings.seeds))
     problems = []

@@ -7,11 +7,12 @@ import statistics
 import subprocess
 from pathlib import Path
 
-from .config import Config, NOT_AVAILABLE_MARKER, SceneInfo, Settings
+from .config import DEFAULT_LIGHT_SELECT, NOT_AVAILABLE_MARKERS, Config, SceneInfo, Settings
 
 
 class McrtError(RuntimeError):
-    """An mcrt invocation failed; ``unavailable`` marks a strategy this build lacks."""
+    """An mcrt invocation failed; ``unavailable`` marks a strategy this build lacks (or lacks for
+    that kind of scene file)."""
 
     def __init__(self, message: str, returncode: int, unavailable: bool) -> None:
         super().__init__(message)
@@ -26,7 +27,7 @@ def run_mcrt(settings: Settings, args: list[str]) -> subprocess.CompletedProcess
     if proc.returncode != 0:
         message = proc.stderr.strip().splitlines()
         text = message[-1] if message else f"exit status {proc.returncode}"
-        unavailable = proc.returncode == 2 and NOT_AVAILABLE_MARKER in proc.stderr
+        unavailable = proc.returncode == 2 and any(m in proc.stderr for m in NOT_AVAILABLE_MARKERS)
         raise McrtError(text, proc.returncode, unavailable)
     return proc
 
@@ -36,8 +37,10 @@ def render(settings: Settings, scene: SceneInfo, config: Config, max_depth: int,
     """Render one image; return render_seconds from --stats (the median over
     settings.time_repeats runs of the same render, which give the same image).
 
-    The integrator, sampler and max depth that --stats reports are checked
-    against those asked for, so a binary that ignored one cannot go unnoticed.
+    The integrator, sampler, max depth, strategy and light selection that
+    --stats reports are checked against those asked for, so a binary that
+    ignored one cannot go unnoticed. The default light selection passes no
+    --light-select (the scene's own).
     """
     stats = image.with_suffix(".stats.json")
     args = ["render", str(scene.path), "-o", str(image), "--spp", str(spp), "--seed", str(seed),
@@ -45,6 +48,11 @@ def render(settings: Settings, scene: SceneInfo, config: Config, max_depth: int,
             "--max-depth", str(max_depth), "--light-sampling", config.strategy,
             "--integrator", config.integrator, "--sampler", config.sampler,
             "--stats", str(stats), "--quiet"]
+    checked = [("integrator", config.integrator), ("sampler", config.sampler), ("max_depth", max_depth),
+               ("light_sampling", config.strategy)]
+    if config.light_select != DEFAULT_LIGHT_SELECT:
+        args += ["--light-select", config.light_select]
+        checked.append(("light_select", config.light_select))
     if settings.threads is not None:
         args += ["--threads", str(settings.threads)]
     seconds = []
@@ -52,8 +60,7 @@ def render(settings: Settings, scene: SceneInfo, config: Config, max_depth: int,
         run_mcrt(settings, args)
         data = json.loads(stats.read_text(encoding="utf-8"))
         stats.unlink(missing_ok=True)
-        for name, asked in (("integrator", config.integrator), ("sampler", config.sampler),
-                            ("max_depth", max_depth), ("light_sampling", config.strategy)):
+        for name, asked in checked:
             if name in data and data[name] != asked:
                 raise McrtError(f"--stats reports {name} {data[name]!r}, asked for {asked!r}", 0, False)
         seconds.append(float(data["render_seconds"]))

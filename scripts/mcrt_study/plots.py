@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 from .analysis import baseline_config, group_stats, mean_curve, slice_of
-from .config import Config, STRATEGY_STYLE, Settings
+from .config import DEFAULT_LIGHT_SELECT, Config, STRATEGY_STYLE, Settings
 
 
 def make_slice_plots(rows: list[dict], settings: Settings, scenes: list[str]) -> list[tuple[str, str]]:
@@ -164,7 +164,7 @@ def make_efficiency_plots(analysis: dict, settings: Settings,
 
     figures: list[tuple[str, str]] = []
     base = baseline_config(settings)
-    groups = [(i, m) for i in settings.integrators for m in settings.samplers]
+    groups = [(i, m, ls) for i in settings.integrators for m in settings.samplers for ls in settings.light_selects]
     width = 0.8 / len(settings.strategies)
     for mode in settings.depths:
         mine = [(sc, d) for sc, m, d in panels if m == mode and analysis[(sc, d)]]
@@ -182,8 +182,8 @@ def make_efficiency_plots(analysis: dict, settings: Settings,
                        key=lambda c: per[c]["efficiency"], default=None)
             for k, strategy in enumerate(settings.strategies):
                 xs, ys, lo, hi = [], [], [], []
-                for g, (integrator, sampler) in enumerate(groups):
-                    a = per.get(Config(strategy, integrator, sampler))
+                for g, (integrator, sampler, select) in enumerate(groups):
+                    a = per.get(Config(strategy, integrator, sampler, select))
                     if a is None or not math.isfinite(a["efficiency"]):
                         continue
                     xs.append(g + (k - (len(settings.strategies) - 1) / 2) * width)
@@ -191,7 +191,7 @@ def make_efficiency_plots(analysis: dict, settings: Settings,
                     se = a["rel_se"] if math.isfinite(a["rel_se"]) else 0.0
                     lo.append(a["efficiency"] * se / (1 + se))
                     hi.append(a["efficiency"] * se)
-                    if Config(strategy, integrator, sampler) == best:
+                    if Config(strategy, integrator, sampler, select) == best:
                         ax.annotate("★", (xs[-1], a["efficiency"] * (1 + se)), ha="center", va="bottom",
                                     fontsize=12)
                 style = STRATEGY_STYLE[strategy]
@@ -202,7 +202,8 @@ def make_efficiency_plots(analysis: dict, settings: Settings,
                            label=f"baseline ({base.integrator}, {base.sampler}, {base.strategy})")
             ax.set_yscale("log")
             ax.set_xticks(range(len(groups)))
-            ax.set_xticklabels([f"{i}\n{m}" for i, m in groups], fontsize=8)
+            ax.set_xticklabels([f"{i}\n{m}" + (f"\n{ls}" if settings.varies_light_select else "")
+                                for i, m, ls in groups], fontsize=8)
             ax.set_title(f"{scene} (max depth {depth})")
             ax.set_ylabel("efficiency 1 / (MSE · s)")
             ax.grid(True, axis="y", which="both", alpha=0.3)
@@ -257,7 +258,8 @@ def make_family_plots(found: list[dict], settings: Settings) -> list[tuple[str, 
     figures: list[tuple[str, str]] = []
     for family, mode in dict.fromkeys((f["family"], f["mode"]) for f in found):
         mine = [f for f in found if (f["family"], f["mode"]) == (family, mode) and f["series"]["ratio"]]
-        groups = list(dict.fromkeys((f["integrator"], f["sampler"]) for f in mine))
+        groups = list(dict.fromkeys((f["integrator"], f["sampler"], f.get("light_select", DEFAULT_LIGHT_SELECT))
+                                    for f in mine))
         if not groups:
             continue
         cols = min(3, len(groups))
@@ -265,10 +267,11 @@ def make_family_plots(found: list[dict], settings: Settings) -> list[tuple[str, 
         fig, axes = plt.subplots(nrows, cols, figsize=(5.6 * cols, 4.4 * nrows), squeeze=False)
         for ax in axes.flat[len(groups):]:
             ax.set_visible(False)
-        for ax, (integrator, sampler) in zip(axes.flat, groups):
+        for ax, (integrator, sampler, select) in zip(axes.flat, groups):
             members: dict[float, float] = {}
             for f in mine:
-                if (f["integrator"], f["sampler"]) != (integrator, sampler):
+                if (f["integrator"], f["sampler"], f.get("light_select", DEFAULT_LIGHT_SELECT)) != (integrator, sampler,
+                                                                                                  select):
                     continue
                 s = f["series"]
                 order = np.argsort(s["solid_angle"])
@@ -301,7 +304,8 @@ def make_family_plots(found: list[dict], settings: Settings) -> list[tuple[str, 
             ax.yaxis.set_minor_formatter(ticker.NullFormatter())
             ax.set_xlabel("light solid angle (sr)")
             ax.set_ylabel("efficiency / area sampling's")
-            ax.set_title(f"{integrator}, {sampler}", fontsize=10)
+            ax.set_title(f"{integrator}, {sampler}" + (f", {select}" if select != DEFAULT_LIGHT_SELECT else ""),
+                         fontsize=10)
             ax.grid(True, which="both", alpha=0.3)
             ax.legend(fontsize=7)
             # The members' family parameter on a top axis at their solid angles.

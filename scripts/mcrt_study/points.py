@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterator
 
-from .config import Config, SceneInfo, Settings
+from .config import DEFAULT_LIGHT_SELECT, Config, SceneInfo, Settings
 from .mcrt import McrtError, diff, render
 from .results import parse_row, row_key, state_key, write_csv
 from .util import log, sha256_json
@@ -84,7 +84,7 @@ def run_point(task: PointTask, measure: Measure = measure_point) -> dict:
     config = task.config
     row = {"scene": task.scene.name, "strategy": config.strategy, "integrator": config.integrator,
            "sampler": config.sampler, "max_depth": task.max_depth, "spp": task.spp, "seed": task.seed,
-           "seconds": seconds, **errors, **task.scene_columns}
+           "seconds": seconds, **errors, **task.scene_columns, "light_select": config.light_select}
     write_point(task.points_dir, row, task.run_key)
     return {"row": row}
 
@@ -103,8 +103,12 @@ def dask_worker_render_threads() -> int | None:
 
 
 def point_file_name(key: tuple) -> str:
-    """The file name of a point (its row_key): a hash, the same on every machine."""
-    return sha256_json(list(key))[:20] + ".json"
+    """The file name of a point (its row_key): a hash, the same on every machine. The key of a
+    point with the default light selection is hashed without it, as before that axis existed."""
+    key = list(key)
+    if len(key) == 8 and key[7] == DEFAULT_LIGHT_SELECT:
+        key = key[:7]
+    return sha256_json(key)[:20] + ".json"
 
 
 def write_point(points_dir: Path, row: dict, run_key: str) -> Path:

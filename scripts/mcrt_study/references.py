@@ -6,7 +6,7 @@ import datetime
 import json
 
 from .config import (
-    Config, LEGACY_INTEGRATOR, LEGACY_SAMPLER, REFERENCES_DIR, REF_STRATEGY_PREFERENCE,
+    Config, DEFAULT_LIGHT_SELECT, LEGACY_INTEGRATOR, LEGACY_SAMPLER, REFERENCES_DIR, REF_STRATEGY_PREFERENCE,
     Reference, SceneInfo, Settings,
 )
 from .mcrt import McrtError, render
@@ -21,11 +21,11 @@ def reference_strategies(settings: Settings) -> list[str]:
 def reference_key(settings: Settings, scene: SceneInfo, max_depth: int, strategy: str,
                   binary_hash: str) -> str:
     """Cache key of a reference: scene content, resolution, spp, depth, seed, strategy,
-    integrator and sampler.
+    integrator, sampler and light selection.
 
     Integrator and sampler enter the key only when they differ from the
-    earlier study's (mixture, independent), so that the references it cached
-    keep their keys.
+    earlier study's (mixture, independent), and the light selection only when
+    it is not the default, so that the references cached before keep their keys.
     """
     key = {
         "scene_sha256": scene.content_sha256,
@@ -39,6 +39,8 @@ def reference_key(settings: Settings, scene: SceneInfo, max_depth: int, strategy
     if (settings.ref_integrator, settings.ref_sampler) != (LEGACY_INTEGRATOR, LEGACY_SAMPLER):
         key["integrator"] = settings.ref_integrator
         key["sampler"] = settings.ref_sampler
+    if settings.ref_light_select != DEFAULT_LIGHT_SELECT:
+        key["light_select"] = settings.ref_light_select
     if settings.ref_key_binary:
         key["mcrt_sha256"] = binary_hash
     return sha256_json(key)[:16]
@@ -59,7 +61,8 @@ def find_cached_reference(settings: Settings, scene: SceneInfo, mode: str, binar
             return Reference(scene=scene.name, mode=mode, max_depth=max_depth, path=image, key=key,
                              strategy=strategy, integrator=settings.ref_integrator,
                              sampler=settings.ref_sampler, spp=settings.ref_spp, seed=settings.ref_seed,
-                             seconds=float(info.get("render_seconds", float("nan"))), cached=True)
+                             seconds=float(info.get("render_seconds", float("nan"))), cached=True,
+                             light_select=settings.ref_light_select)
     return None
 
 
@@ -85,7 +88,7 @@ def make_reference(settings: Settings, scene: SceneInfo, mode: str, binary_hash:
             return cached
         key = reference_key(settings, scene, max_depth, strategy, binary_hash)
         image = refdir / f"{scene.name}-{key}.exr"
-        config = Config(strategy, settings.ref_integrator, settings.ref_sampler)
+        config = Config(strategy, settings.ref_integrator, settings.ref_sampler, settings.ref_light_select)
         say = progress.message if progress else log
         say(f"reference {scene.name} ({mode}, max depth {max_depth}): {settings.ref_spp} spp, "
             f"{scene.width}x{scene.height}, {config.label}, seed {settings.ref_seed}")
@@ -101,13 +104,14 @@ def make_reference(settings: Settings, scene: SceneInfo, mode: str, binary_hash:
             "scene": scene.name, "scene_file": str(scene.path), "scene_sha256": scene.content_sha256,
             "width": scene.width, "height": scene.height, "spp": settings.ref_spp, "mode": mode,
             "max_depth": max_depth, "seed": settings.ref_seed, "strategy": strategy,
-            "integrator": config.integrator, "sampler": config.sampler,
+            "integrator": config.integrator, "sampler": config.sampler, "light_select": config.light_select,
             "render_seconds": seconds, "mcrt": str(settings.mcrt), "mcrt_sha256": binary_hash,
             "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         }
         write_text_atomic(image.with_suffix(".json"), json.dumps(meta, indent=2) + "\n")
         return Reference(scene=scene.name, mode=mode, max_depth=max_depth, path=image, key=key,
                          strategy=strategy, integrator=config.integrator, sampler=config.sampler,
-                         spp=settings.ref_spp, seed=settings.ref_seed, seconds=seconds, cached=False)
+                         spp=settings.ref_spp, seed=settings.ref_seed, seconds=seconds, cached=False,
+                         light_select=config.light_select)
     assert last_error is not None
     raise last_error

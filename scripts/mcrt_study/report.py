@@ -14,7 +14,7 @@ from .analysis import (
     loglog_slope, mean_curve, scene_panels, slice_of, slice_rows,
 )
 from .config import (
-    Config, DIRECT_MAX_DEPTH, Failure, LEGACY_INTEGRATOR, LEGACY_SAMPLER, REPORT_MD, REPO_ROOT,
+    DEFAULT_LIGHT_SELECT, Config, DIRECT_MAX_DEPTH, Failure, LEGACY_INTEGRATOR, LEGACY_SAMPLER, REPORT_MD, REPO_ROOT,
     RESULTS_CSV, SAMPLER_DESCRIPTIONS, STATE_JSON, SceneInfo, Settings, TABLES_MD, repo_relative,
 )
 from .results import read_state, state_key
@@ -156,9 +156,20 @@ def panel_title(scene: str, mode: str, depth: int) -> str:
     return f"{scene}, {mode} (max depth {depth})"
 
 
-def config_cells(config: Config) -> list[str]:
-    """The integrator, sampler and strategy columns of a configuration's table row."""
-    return [config.integrator, config.sampler, config.strategy]
+def cells_of(config: Config, with_select: bool = False) -> list[str]:
+    """The integrator, sampler (light selection) and strategy columns of a configuration's table row."""
+    return [config.integrator, config.sampler, *([config.light_select] if with_select else []), config.strategy]
+
+
+def config_header(with_select: bool = False) -> list[str]:
+    """The headers of cells_of's columns."""
+    return ["integrator", "sampler", *(["light selection"] if with_select else []), "strategy"]
+
+
+def config_text(config: Config, with_select: bool = False) -> str:
+    """A configuration in words: 'mixture, independent, area' (', light selection bvh' added)."""
+    return (f"{config.integrator}, {config.sampler}, {config.strategy}"
+            + (f", light selection {config.light_select}" if with_select else ""))
 
 
 def bold(text: str, on: bool) -> str:
@@ -172,6 +183,11 @@ def build_config_tables(analysis: dict, settings: Settings,
     MSE at equal time, RMSE slopes; and the numbers the checks use."""
     base = baseline_config(settings)
     configs = [c for c in settings.configs if any(c in analysis[(sc, d)] for sc, _, d in panels)]
+    with_select = settings.varies_light_select
+    columns = config_header(with_select)
+
+    def config_cells(c: Config) -> list[str]:  # this run's columns
+        return cells_of(c, with_select)
     summary: dict = {"efficiency": {}, "config_slopes": {}, "best": {}}
     parts: list[str] = []
     if not configs:
@@ -198,12 +214,12 @@ def build_config_tables(analysis: dict, settings: Settings,
         "than 1/spp (see the convergence rates below) efficiency grows with spp, and this is the "
         "efficiency near the geometric middle of the spp list; every configuration has the same "
         "spp list, so the ratios compare them at equal spp. Ratios are to the baseline "
-        f"({base.integrator}, {base.sampler}, {base.strategy}) of the same scene and depth mode; "
+        f"({config_text(base, with_select)}) of the same scene and depth mode; "
         "higher is better, the best configuration of each column is in bold. In the tables per "
         "scene, ± s.e. is the standard error of the geometric mean from the spread of the renders "
         "over seeds at equal spp (machine-speed and Monte-Carlo noise, not the trend over spp); "
         "ms per spp is at the largest spp.\n\n")
-    header = ["integrator", "sampler", "strategy"]
+    header = list(columns)
     header += [f"{scene} {mode}" for scene, mode, _ in panels]
     table = []
     for c in configs:
@@ -211,7 +227,7 @@ def build_config_tables(analysis: dict, settings: Settings,
         for scene, _, depth in panels:
             line.append(bold(fmt(ratio(scene, depth, c), 3), summary["best"].get((scene, depth)) == c))
         table.append(line)
-    parts.append(md_table(header, table, 3))
+    parts.append(md_table(header, table, len(columns)))
     for scene, mode, depth in panels:
         per = analysis[(scene, depth)]
         parts.append(f"\n#### {panel_title(scene, mode, depth)}\n\n")
@@ -227,8 +243,8 @@ def build_config_tables(analysis: dict, settings: Settings,
             table.append([*config_cells(c), str(a["n"]), bold(fmt(a["efficiency"], 4), best),
                           f"±{fmt(100 * a['rel_se'], 2)} %", bold(fmt(ratio(scene, depth, c), 3), best),
                           fmt(a["ms_per_spp"], 3), "★ best" if best else ""])
-        parts.append(md_table(["integrator", "sampler", "strategy", "renders", "efficiency",
-                               "± s.e.", "× baseline", "ms per spp", ""], table, 3))
+        parts.append(md_table([*columns, "renders", "efficiency",
+                               "± s.e.", "× baseline", "ms per spp", ""], table, len(columns)))
 
     # Equal time.
     parts.append(
@@ -262,8 +278,9 @@ def build_config_tables(analysis: dict, settings: Settings,
             table.append([*config_cells(c), *[bold(fmt(m, 4), m == lowest[i]) for i, m in enumerate(mse[c])],
                           fmt(gain, 3)])
         parts.append(f"\n#### {panel_title(scene, mode, depth)}\n\n")
-        parts.append(md_table(["integrator", "sampler", "strategy",
-                               *[f"MSE at {fmt(b, 3)} s" for b in budgets], "baseline MSE / MSE"], table, 3))
+        parts.append(md_table([*columns,
+                               *[f"MSE at {fmt(b, 3)} s" for b in budgets], "baseline MSE / MSE"], table,
+                              len(columns)))
 
     # Convergence rates.
     parts.append(
@@ -281,8 +298,8 @@ def build_config_tables(analysis: dict, settings: Settings,
     for c in configs:
         table.append([*config_cells(c), *[fmt(analysis[(sc, d)][c]["slope"], 3) if c in analysis[(sc, d)]
                                           else "–" for sc, _, d in panels]])
-    parts.append(md_table(["integrator", "sampler", "strategy", *[f"{sc} {m}" for sc, m, _ in panels]],
-                          table, 3))
+    parts.append(md_table([*columns, *[f"{sc} {m}" for sc, m, _ in panels]],
+                          table, len(columns)))
     return "".join(parts), summary
 
 
@@ -411,11 +428,13 @@ def failure_lines(failures: list[Failure]) -> list[str]:
     """The report's lines for skipped or failed configurations, one per scene, strategy and reason."""
     grouped: dict[tuple, list[str]] = {}
     for f in failures:
-        where = f"{f.integrator}/{f.sampler}" + (f" at max depth {f.max_depth}" if f.max_depth is not None else "")
+        where = (f"{f.integrator}/{f.sampler}"
+                 + (f"/{f.light_select}" if f.light_select != DEFAULT_LIGHT_SELECT else "")
+                 + (f" at max depth {f.max_depth}" if f.max_depth is not None else ""))
         grouped.setdefault((f.scene, f.strategy, f.unavailable, f.message), []).append(where)
     lines = []
     for (scene, strategy, unavailable, message), where in grouped.items():
-        kind = "not available in this mcrt build, skipped" if unavailable else "**failed**"
+        kind = "not available in this mcrt build (for this scene), skipped" if unavailable else "**failed**"
         lines.append(f"- {scene}, {strategy} ({'; '.join(dict.fromkeys(where))}): {kind} — `{message}`")
     return lines
 
@@ -428,9 +447,14 @@ def scene_lines(scenes: list[SceneInfo]) -> list[str]:
     return ["### Scenes\n",
             "Generated families (scene files in `scenes/` of this directory; see "
             "`scripts/mcrt_study/scenes.py`): size_* — light area relative to the Cornell box's 130×105 ceiling light; "
-            "distance — light height over the floor relative to its size (130). Solid angle (sr) of the "
-            "first light seen from the box's centre (278, 278, 279.5), for the distance family from the "
-            "floor point under the light.\n",
+            "distance — light height over the floor relative to its size (130); tri_size — triangle area "
+            "relative to the reference triangle's (equilateral, edge 1); tri_distance — its height over "
+            "the floor in edges; tri_aspect — base / height relative to the equilateral's (slivers of "
+            "the same area); tri_grazing — the cosine between its normal and straight down; "
+            "many_lights — the number of emitters (12,800 triangles for the mesh). Solid angle (sr) of the "
+            "first light seen from the box's centre (278, 278, 279.5), for the distance and triangle "
+            "families from the floor point under the light, for many_lights the median over its "
+            "emitting triangles seen from the floor point (0, 0, 0.5).\n",
             md_table(["scene", "family", "parameter", "light solid angle (sr)"], rows, 2)]
 
 
@@ -464,8 +488,9 @@ def write_report(settings: Settings, scenes: list[SceneInfo], tables: str,
         f"render threads: {threads}",
         f"- Scenes: {', '.join(sc.name for sc in scenes)}",
         f"- Configurations ({len(settings.configs)}): integrators {', '.join(settings.integrators)}; "
-        f"samplers {', '.join(settings.samplers)}; strategies {', '.join(settings.strategies)}; "
-        f"in the depth modes {' and '.join(modes[m] for m in settings.depths)}",
+        f"samplers {', '.join(settings.samplers)}; "
+        + (f"light selections {', '.join(settings.light_selects)}; " if settings.varies_light_select else "")
+        + f"strategies {', '.join(settings.strategies)}; in the depth modes {' and '.join(modes[m] for m in settings.depths)}",
         f"- Sweep: spp {', '.join(map(str, settings.spp))}; seeds {', '.join(map(str, settings.seeds))}; "
         "for each seed and spp every depth mode and configuration in turn",
         "- Time: `render_seconds` of `mcrt render --stats` (rendering only: no process start, "
@@ -475,7 +500,7 @@ def write_report(settings: Settings, scenes: list[SceneInfo], tables: str,
         "(relMSE as in pbrt: mean of (v−r)²/(r+0.01)²).",
         "- Efficiency: 1/(MSE × seconds) of each render; a configuration's is the geometric mean "
         "over its renders (every spp and seed), compared with the baseline "
-        f"({base.integrator}, {base.sampler}, {base.strategy}) of the same scene and depth mode.",
+        f"({config_text(base, settings.varies_light_select)}) of the same scene and depth mode.",
         f"- Data: [{RESULTS_CSV}]({RESULTS_CSV}) (one row per render), tables also in [{TABLES_MD}]({TABLES_MD}).\n",
     ]
     lines += scene_lines(scenes)
@@ -485,22 +510,32 @@ def write_report(settings: Settings, scenes: list[SceneInfo], tables: str,
         "every configuration (all converge to the same image); the table gives the configuration "
         f"each was rendered with (this run's choice: integrator {settings.ref_integrator}, sampler "
         f"{settings.ref_sampler}, "
+        + (f"light selection {settings.ref_light_select}, " if settings.ref_light_select != DEFAULT_LIGHT_SELECT
+           else "")
         + ("solid-angle sampling where this mcrt build supports it, else area sampling"
            if settings.ref_strategy == "preferred" else f"{settings.ref_strategy} sampling")
         + "). Cached by scene content, resolution, spp, max depth, seed, strategy, integrator and sampler.\n",
     ]
     ref_rows = []
+    ref_selects = False  # a light selection column when any reference has one of its own
     for scene, mode, depth in scene_panels(scenes, settings):
         s = state.get("runs", {}).get(state_key(scene, depth))
         if s:
             ref = s["reference"]
+            select = ref.get("light_select", DEFAULT_LIGHT_SELECT)
+            ref_selects = ref_selects or select != DEFAULT_LIGHT_SELECT
             ref_rows.append([scene, mode, ref.get("integrator", LEGACY_INTEGRATOR),
-                             ref.get("sampler", LEGACY_SAMPLER), ref["strategy"], f"{s['width']}×{s['height']}",
-                             str(depth), str(ref["spp"]), str(ref["seed"]),
+                             ref.get("sampler", LEGACY_SAMPLER), select, ref["strategy"],
+                             f"{s['width']}×{s['height']}", str(depth), str(ref["spp"]), str(ref["seed"]),
                              fmt(ref.get("render_seconds", float("nan")), 4)])
     if ref_rows:
-        lines.append(md_table(["scene", "mode", "integrator", "sampler", "strategy", "resolution", "max depth",
-                               "spp", "seed", "render time (s)"], ref_rows, 5))
+        header = ["scene", "mode", "integrator", "sampler", "light selection", "strategy", "resolution",
+                  "max depth", "spp", "seed", "render time (s)"]
+        if not ref_selects:
+            header.pop(4)
+            for row in ref_rows:
+                row.pop(4)
+        lines.append(md_table(header, ref_rows, len(header) - 5))
     if settings.failures:
         lines.append("### Skipped or failed\n")
         lines += failure_lines(settings.failures)
@@ -546,9 +581,14 @@ def family_section(found: list[dict], figures: list[tuple[str, str]]) -> str:
     for f in found:
         r = f["series"]["ratio"]
         span = f"{fmt(min(r), 3)} – {fmt(max(r), 3)}" if r else "–"
-        rows.append([f["family"], f"{f['mode']}, {f['integrator']}, {f['sampler']}", f["strategy"],
+        select = f.get("light_select", DEFAULT_LIGHT_SELECT)
+        where = f"{f['mode']}, {f['integrator']}, {f['sampler']}" + (f", {select}" if select != DEFAULT_LIGHT_SELECT
+                                                                      else "")
+        rows.append([f["family"], where, f["strategy"],
                      str(len(r)), span, crossover_cell(f)])
-    parts.append(md_table(["family", "slice (depth, integrator, sampler)", "strategy", "members",
+    selects = any(f.get("light_select", DEFAULT_LIGHT_SELECT) != DEFAULT_LIGHT_SELECT for f in found)
+    slice_header = "slice (depth, integrator, sampler" + (", light selection)" if selects else ")")
+    parts.append(md_table(["family", slice_header, "strategy", "members",
                            "ratio range", "crossover solid angle (parameter)"], rows, 3))
     families = list(dict.fromkeys(f["family"] for f in found))
     parts.append("\nParameters: " + "; ".join(f"{fam}: {family_param_label(fam)}" for fam in families) + ".\n")

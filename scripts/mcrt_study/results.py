@@ -9,22 +9,24 @@ from pathlib import Path
 from typing import Callable
 
 from .config import (
-    CSV_COLUMNS, Config, LEGACY_INTEGRATOR, LEGACY_SAMPLER, MCRT_DEFAULT_MAX_DEPTH,
-    OLD_CSV_COLUMNS, PRE_FAMILY_CSV_COLUMNS, Reference, SCENES_DIR, STATE_VERSION, SceneInfo, Settings,
+    CSV_COLUMNS, Config, DEFAULT_LIGHT_SELECT, LEGACY_INTEGRATOR, LEGACY_SAMPLER, MCRT_DEFAULT_MAX_DEPTH,
+    OLD_CSV_COLUMNS, PRE_FAMILY_CSV_COLUMNS, PRE_SELECT_CSV_COLUMNS, Reference, SCENES_DIR, STATE_VERSION,
+    SceneInfo, Settings,
 )
 from .scenes import family_member, scene_columns, scene_file_max_depth, scene_path
 from .util import log, sha256_json
 
 
 def row_key(row: dict) -> tuple:
-    """What identifies a point: scene, configuration, max depth, spp, seed."""
+    """What identifies a point: scene, configuration (strategy, integrator, sampler), max depth,
+    spp, seed, light selection."""
     return (row["scene"], row["strategy"], row["integrator"], row["sampler"], row["max_depth"],
-            row["spp"], row["seed"])
+            row["spp"], row["seed"], row.get("light_select") or DEFAULT_LIGHT_SELECT)
 
 
 def point_key(scene: str, config: Config, max_depth: int, spp: int, seed: int) -> tuple:
     """row_key of the point not rendered yet."""
-    return (scene, config.strategy, config.integrator, config.sampler, max_depth, spp, seed)
+    return (scene, config.strategy, config.integrator, config.sampler, max_depth, spp, seed, config.light_select)
 
 
 def parse_row(r: dict) -> dict:
@@ -34,7 +36,8 @@ def parse_row(r: dict) -> dict:
             "seed": int(r["seed"]), "seconds": float(r["seconds"]), "rmse": float(r["rmse"]),
             "mse": float(r["mse"]), "relmse": float(r["relmse"]), "family": r.get("family") or "",
             "family_param": optional_float(r.get("family_param")),
-            "light_solid_angle": optional_float(r.get("light_solid_angle"))}
+            "light_solid_angle": optional_float(r.get("light_solid_angle")),
+            "light_select": r.get("light_select") or DEFAULT_LIGHT_SELECT}
 
 
 def optional_float(value: object) -> float | None:
@@ -87,8 +90,10 @@ def read_csv(path: Path, legacy_depth: Callable[[str], int],
     A CSV of the earlier format (no integrator, sampler, max_depth) is read as
     integrator mixture, sampler independent, max depth `legacy_depth(scene)`;
     one without the family columns (family, family_param, light_solid_angle)
-    gets them from `columns(scene)` (default: scenes.scene_columns); either is
-    rewritten in the current format. Any other header is refused.
+    gets them from `columns(scene)` (default: scenes.scene_columns); one without
+    the light_select column (these and all the earlier) is read as light
+    selection "default" (no --light-select was passed); each is rewritten in the
+    current format. Any other header is refused.
     """
     columns = columns or scene_columns
     if not path.is_file():
@@ -98,6 +103,12 @@ def read_csv(path: Path, legacy_depth: Callable[[str], int],
         header, raw = reader.fieldnames, list(reader)
     if header == CSV_COLUMNS:
         return [parse_row(r) for r in raw]
+    if header == PRE_SELECT_CSV_COLUMNS:
+        rows = [parse_row(r) for r in raw]
+        write_csv(path, rows)
+        log(f"{path.name}: {len(rows)} rows without the light_select column read as light selection "
+            f"{DEFAULT_LIGHT_SELECT}; rewritten with the columns " + ",".join(CSV_COLUMNS))
+        return rows
     if header == PRE_FAMILY_CSV_COLUMNS:
         rows = [{**parse_row(r), **columns(r["scene"])} for r in raw]
         write_csv(path, rows)
@@ -133,7 +144,8 @@ def format_row(row: dict) -> dict:
             **{k: f"{row[k]:.9g}" for k in ("seconds", "rmse", "mse", "relmse")},
             "family": row.get("family") or "",
             "family_param": "" if row.get("family_param") is None else f"{row['family_param']:.9g}",
-            "light_solid_angle": "" if row.get("light_solid_angle") is None else f"{row['light_solid_angle']:.9g}"}
+            "light_solid_angle": "" if row.get("light_solid_angle") is None else f"{row['light_solid_angle']:.9g}",
+            "light_select": row.get("light_select") or DEFAULT_LIGHT_SELECT}
 
 
 def append_csv(path: Path, row: dict) -> None:

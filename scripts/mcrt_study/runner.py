@@ -43,7 +43,8 @@ def point_work(scene: SceneInfo, config: Config, max_depth: int, spp: int) -> fl
 
 def reference_work(settings: Settings, scene: SceneInfo, max_depth: int) -> float:
     """Estimated work of one reference, in samples."""
-    config = Config(reference_strategies(settings)[0], settings.ref_integrator, settings.ref_sampler)
+    config = Config(reference_strategies(settings)[0], settings.ref_integrator, settings.ref_sampler,
+                    settings.ref_light_select)
     return point_work(scene, config, max_depth, settings.ref_spp) - PROCESS_OVERHEAD_SAMPLES
 
 
@@ -151,7 +152,7 @@ def prepare_depth(sweep: Sweep, scene: SceneInfo, mode: str, counted: bool) -> R
         progress.message(f"{scene.name} ({mode}): reference failed: {err}")
         for config in settings.configs:
             settings.failures.append(Failure(scene.name, config.strategy, f"reference: {err}", False,
-                                             config.integrator, config.sampler, depth))
+                                             config.integrator, config.sampler, depth, config.light_select))
         left = sum(point_work(scene, config, depth, spp)
                    for config, spp, seed in itertools.product(settings.configs, settings.spp, settings.seeds)
                    if point_key(scene.name, config, depth, spp, seed) not in sweep.done)
@@ -182,6 +183,7 @@ def prepare_depth(sweep: Sweep, scene: SceneInfo, mode: str, counted: bool) -> R
         "width": scene.width, "height": scene.height, "max_depth": depth,
         "reference": {"file": os.path.relpath(reference.path, settings.out), "strategy": reference.strategy,
                       "integrator": reference.integrator, "sampler": reference.sampler,
+                      "light_select": reference.light_select,
                       "spp": reference.spp, "seed": reference.seed, "render_seconds": reference.seconds},
     }
     sweep.save_state()
@@ -255,7 +257,7 @@ def sweep_scene(sweep: Sweep, scene: SceneInfo, references: dict[int, Reference]
         while room > 0 and (point := next_point()) is not None:
             config, depth = point.config, point.max_depth
             image = sweep.tmpdir / (f"{scene.name}-{depth}-{config.strategy}-{config.integrator}-"
-                                    f"{config.sampler}-{point.spp}-{point.seed}.exr")
+                                    f"{config.sampler}-{config.light_select}-{point.spp}-{point.seed}.exr")
             task = PointTask(point_settings, scene, config, depth, point.spp, point.seed, image,
                              references[depth].path, sweep.points_dir, run_keys[depth], columns,
                              sweep.share_worker_cores)
@@ -298,10 +300,10 @@ def record_outcome(sweep: Sweep, scene: SceneInfo, point: Point, mode: str, futu
         return None
     err = McrtError(outcome["error"], outcome["returncode"], outcome["unavailable"])
     dead[(depth, config)] = str(err)
-    kind = "not available in this build, skipped" if err.unavailable else "FAILED"
+    kind = "not available in this build (for this scene), skipped" if err.unavailable else "FAILED"
     progress.message(f"{scene.name} ({mode}) {config.label}: {kind}: {err}")
     settings.failures.append(Failure(scene.name, config.strategy, str(err), err.unavailable,
-                                     config.integrator, config.sampler, depth))
+                                     config.integrator, config.sampler, depth, config.light_select))
     left = sum(point_work(scene, config, depth, s) for s in settings.spp for sd in settings.seeds
                if point_key(scene.name, config, depth, s, sd) not in sweep.done
                and point_key(scene.name, config, depth, s, sd) not in inflight)

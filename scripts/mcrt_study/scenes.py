@@ -10,11 +10,17 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
 from pathlib import Path
 
-from .config import DEFAULT_SCALE, GENERATED_SCENES_DIR, MCRT_DEFAULT_MAX_DEPTH, SCENES_DIR, SceneInfo, Settings
-from .util import sha256_file
+from .config import (
+    DEFAULT_SCALE, GENERATED_SCENES_DIR, MCRT_DEFAULT_MAX_DEPTH, SCENES_DIR, FamilyMember, SceneInfo, Settings,
+)
+from .pbrt_families import PBRT_FAMILIES, pbrt_file_settings
+from .solid_angles import (  # noqa: F401 (re-exported: the solid angles of lights)
+    _cross, _dot, _sub, disk_solid_angle_on_axis, ellipse_solid_angle, polygon_solid_angle, sphere_solid_angle,
+    triangle_solid_angle, triangles_solid_angles,
+)
+from .util import bad_input, sha256_file
 
 
 def scene_path(spec: str) -> Path:
@@ -25,6 +31,8 @@ def scene_path(spec: str) -> Path:
 
 def scene_file_max_depth(path: Path) -> int:
     """The max depth a scene file asks for (mcrt's default when it gives none)."""
+    if path.suffix == ".pbrt":
+        return pbrt_file_settings(path.read_text(encoding="utf-8"))[2]
     render = json.loads(path.read_text(encoding="utf-8")).get("render", {})
     return int(render.get("max_depth", MCRT_DEFAULT_MAX_DEPTH))
 
@@ -37,21 +45,30 @@ def load_scene(spec: str, settings: Settings) -> SceneInfo:
     member = family_member(spec)
     path = write_member(member, settings.out) if member is not None else scene_path(spec)
     if not path.is_file():
-        raise SystemExit(f"study.py: scene not found: {spec}")
-    data = json.loads(path.read_text(encoding="utf-8"))
-    camera = data.get("camera", {})
-    width = settings.width or int(round(int(camera.get("width", 0)) * DEFAULT_SCALE))
-    height = settings.height or int(round(int(camera.get("height", 0)) * DEFAULT_SCALE))
+        raise bad_input(f"scene not found: {spec}")
+    if path.suffix == ".pbrt":  # a pbrt-v4 file: its Film's resolution, its Integrator's maxdepth
+        data: dict = {}
+        own_width, own_height, own_depth = pbrt_file_settings(path.read_text(encoding="utf-8"))
+    else:
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except ValueError as err:
+            raise bad_input(f"{path}: not a JSON scene file ({err})")
+        camera = data.get("camera", {})
+        own_width, own_height = int(camera.get("width", 0)), int(camera.get("height", 0))
+        own_depth = int(data.get("render", {}).get("max_depth", MCRT_DEFAULT_MAX_DEPTH))
+    width = settings.width or int(round(own_width * DEFAULT_SCALE))
+    height = settings.height or int(round(own_height * DEFAULT_SCALE))
     if width <= 0 or height <= 0:
-        raise SystemExit(f"study.py: {path}: no camera width/height; pass --width and --height")
-    max_depth = settings.max_depth or scene_file_max_depth(path)
+        raise bad_input(f"{path}: no camera width/height; pass --width and --height")
+    max_depth = settings.max_depth or own_depth
     if member is not None:
         return SceneInfo(name=member.name, path=path.resolve(), content_sha256=sha256_file(path),
                          width=width, height=height, max_depth=max_depth, family=member.family,
                          family_param=member.param, light_solid_angle=member.solid_angle)
     return SceneInfo(name=path.stem, path=path.resolve(), content_sha256=sha256_file(path),
                      width=width, height=height, max_depth=max_depth,
-                     light_solid_angle=first_light_solid_angle(data, CORNELL_CENTRE))
+                     light_solid_angle=first_light_solid_angle(data, CORNELL_CENTRE) if data else None)
 
 
 
@@ -100,9 +117,51 @@ def load_scenes(specs: list[str], settings: Settings) -> list[SceneInfo]:
 #   below the light at the largest height (which is then out of the frame), and
 #   above the others, whose backs (black) hide some floor beyond the light.
 #
-# Each member has a family parameter (light area / 13,650, or h / 130) and the
-# light's solid angle seen from the family's reference point: the centre of the
-# box (278, 278, 279.5), or the floor point under the light's centre.
+# The triangle and many-light families are pbrt-v4 files (OUT/scenes/NAME.pbrt;
+# the JSON format has no triangles), written by pbrt_families.py:
+#
+# tri_size, tri_distance, tri_aspect, tri_grazing: one emissive triangle (a
+#   trianglemesh with AreaLightSource "diffuse", black material: a pure emitter)
+#   over a 400x400 diffuse floor (albedo 0.73) with a cube (side 0.5, the same
+#   white) standing at (-2, 0, -2) beside it; lengths in units of the reference
+#   triangle's edge: equilateral, edge 1 (area sqrt(3)/4), centroid 1 above the
+#   floor point (0, 0, 0), facing down, radiance 10. Every member's radiance is
+#   10 x sqrt(3)/4 / its area (area from the corners as written), so every
+#   member emits the reference's power. The camera (LookAt, Camera
+#   "perspective", fov 40, 600x600, box filter, maxdepth 50) looks at the floor
+#   point under the light from 10 units away, 45 degrees up, from the (-x, +z)
+#   side; it sees the backs (black) of the triangles, never their emission.
+#   tri_size: the equilateral triangle at 1/16, 1/4, 1, 2, 4, 8 times the
+#     reference's area (members tri_size_1of16 ... tri_size_x8).
+#   tri_distance: the reference triangle at heights h = 0.01, 0.03, 0.1, 0.3,
+#     1, 3, 10 (h / edge; members tri_distance_h0.01 ... tri_distance_h10).
+#   tri_aspect: slivers of the reference's area, an isosceles triangle with
+#     its base along x sqrt(k) times the equilateral's and its height 1/sqrt(k)
+#     times, so base / height is k times the equilateral's, k = 1, 10, 100,
+#     1000, 10^4 (members tri_aspect_a1 ... tri_aspect_a10000; the last is 100
+#     long and 0.0087 wide).
+#   tri_grazing: the reference triangle tilted about the x axis (towards -z)
+#     until the cosine between its normal and straight down is c = 1, 0.5, 0.1,
+#     0.03, 0.01, 0.001 (members tri_grazing_c1 ... tri_grazing_c0.001): its
+#     plane then passes at a distance c from the floor point under it, and the
+#     floor along the line it cuts sees it at grazing angles (the floor beyond
+#     it, +z, nearly not at all).
+# many_lights: the scenes of many_lights_scenes.py (bench/many_lights.py's),
+#   320x240: a 20x20 floor with 40 boxes under N = 10, 100, 1000, 10^4, 10^5
+#   small emitters (triangles and quads, facing down, radiance log-uniform over
+#   three decades; members many_lights_n10 ... many_lights_n100000), and the same
+#   floor beside a wavy emissive curtain of 12,800 triangles and 20 small
+#   lights (many_lights_mesh); every radiance scaled so that each member emits
+#   a power (pi x radiance x area, summed) of 100. The files of 10^4 and 10^5
+#   lights take seconds to make (3 and 30 MB).
+#
+# Each member has a family parameter (light area / 13,650, or h / 130; for the
+# triangles area / the reference's, h / edge, k, c; for many_lights the number
+# of emitters, 12,800 for the mesh) and the light's solid angle seen from the
+# family's reference point: the centre of the box (278, 278, 279.5), or the
+# floor point under the light's centre; for many_lights the median over its
+# emitting triangles of their solid angle from the floor point the camera
+# looks at, (0, 0, 0.5).
 # --------------------------------------------------------------------------
 
 CORNELL_CENTRE = (278.0, 278.0, 279.5)
@@ -145,17 +204,6 @@ CORNELL_OBJECTS_AFTER_LIGHT = [
     TALL_BOX,
     SHORT_BOX,
 ]
-
-
-@dataclass(frozen=True)
-class FamilyMember:
-    """One generated scene: its name, family, family parameter, scene data and light solid angle (sr)."""
-
-    name: str
-    family: str
-    param: float
-    scene: dict
-    solid_angle: float
 
 
 def _num(x: float) -> float | int:
@@ -279,7 +327,7 @@ def distance_family() -> list[FamilyMember]:
 
 
 FAMILIES = {"size_rect": size_rect_family, "size_disk": size_disk_family, "size_sphere": size_sphere_family,
-            "distance": distance_family}
+            "distance": distance_family, **PBRT_FAMILIES}
 
 
 def family_member(name: str) -> FamilyMember | None:
@@ -308,74 +356,25 @@ def scene_text(scene: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def member_text(member: FamilyMember) -> str:
+    """The text of a member's scene file: JSON (scene_text) or pbrt-v4."""
+    scene = member.scene
+    if isinstance(scene, dict):
+        return scene_text(scene)
+    return scene if isinstance(scene, str) else scene()
+
+
 def write_member(member: FamilyMember, out: Path) -> Path:
-    """Write a member's scene file to OUT/scenes/NAME.json (left untouched when already identical)."""
-    path = out / GENERATED_SCENES_DIR / f"{member.name}.json"
-    text = scene_text(member.scene)
+    """Write a member's scene file to OUT/scenes/NAME.json or NAME.pbrt (left untouched when already
+    identical)."""
+    path = out / GENERATED_SCENES_DIR / f"{member.name}{member.suffix}"
+    text = member_text(member)
     if not (path.is_file() and path.read_text(encoding="utf-8") == text):
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_name(f".{path.name}.tmp")
         tmp.write_text(text, encoding="utf-8")
         tmp.replace(path)
     return path
-
-
-# Solid angles (steradians) of lights seen from a point.
-
-def _sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def triangle_solid_angle(p, a, b, c) -> float:
-    """Solid angle of a triangle from p (Van Oosterom and Strackee 1983)."""
-    r1, r2, r3 = _sub(a, p), _sub(b, p), _sub(c, p)
-    l1, l2, l3 = (math.sqrt(_dot(r, r)) for r in (r1, r2, r3))
-    numerator = abs(_dot(r1, _cross(r2, r3)))
-    denominator = l1 * l2 * l3 + _dot(r1, r2) * l3 + _dot(r1, r3) * l2 + _dot(r2, r3) * l1
-    return 2.0 * math.atan2(numerator, denominator)
-
-
-def polygon_solid_angle(p, corners) -> float:
-    """Solid angle of a convex planar polygon (corners in order) from p: a fan of triangles."""
-    return sum(triangle_solid_angle(p, corners[0], corners[i], corners[i + 1]) for i in range(1, len(corners) - 1))
-
-
-def disk_solid_angle_on_axis(distance: float, radius: float) -> float:
-    """Solid angle of a disk from a point on its axis: 2 pi (1 - h / sqrt(h^2 + R^2))."""
-    h = abs(distance)
-    return 2.0 * math.pi * (1.0 - h / math.sqrt(h * h + radius * radius))
-
-
-def ellipse_solid_angle(p, centre, axis1, axis2, n: int = 4096) -> float:
-    """Solid angle of an ellipse from p, as that of an n-gon of the same area inscribed in its shape (the
-    solid angle of a planar figure depends on its outline only): a fan of triangles from the centre."""
-    import numpy as np
-    phi = np.arange(n + 1) / n * 2 * np.pi
-    stretch = math.sqrt(math.pi / (n / 2 * math.sin(2 * math.pi / n)))  # n-gon area = ellipse area
-    c, a1, a2 = (np.asarray(v, float) for v in (centre, axis1, axis2))
-    ring = c + stretch * (np.cos(phi)[:, None] * a1 + np.sin(phi)[:, None] * a2)
-    r1 = c - np.asarray(p, float)
-    r2, r3 = ring[:-1] - np.asarray(p, float), ring[1:] - np.asarray(p, float)
-    l1, l2, l3 = np.linalg.norm(r1), np.linalg.norm(r2, axis=1), np.linalg.norm(r3, axis=1)
-    numerator = np.abs(np.cross(r2, r3) @ r1)
-    denominator = l1 * l2 * l3 + (r2 @ r1) * l3 + (r3 @ r1) * l2 + np.einsum("ij,ij->i", r2, r3) * l1
-    return float(np.sum(2.0 * np.arctan2(numerator, denominator)))
-
-
-def sphere_solid_angle(distance: float, radius: float) -> float:
-    """Solid angle of a sphere from a point at `distance` from its centre: 2 pi (1 - sqrt(1 - (r/d)^2));
-    4 pi from inside or on it."""
-    if distance <= radius:
-        return 4.0 * math.pi
-    return 2.0 * math.pi * (1.0 - math.sqrt(1.0 - (radius / distance) ** 2))
 
 
 def light_solid_angle(obj: dict, p) -> float | None:
@@ -437,7 +436,7 @@ def scene_columns(name: str, path: Path | None = None) -> dict:
         return {"family": member.family, "family_param": member.param, "light_solid_angle": member.solid_angle}
     path = path or SCENES_DIR / f"{name}.json"
     solid_angle = None
-    if path.is_file():
+    if path.is_file() and path.suffix == ".json":
         try:
             solid_angle = first_light_solid_angle(json.loads(path.read_text(encoding="utf-8")), CORNELL_CENTRE)
         except ValueError:

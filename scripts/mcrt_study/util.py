@@ -37,6 +37,12 @@ def log(message: str) -> None:
     print(f"study: {message}", file=sys.stderr, flush=True)
 
 
+def bad_input(message: str) -> SystemExit:
+    """Print one line, 'study.py: MESSAGE', on stderr and return the SystemExit (status 2) to raise."""
+    print(f"study.py: {message}", file=sys.stderr, flush=True)
+    return SystemExit(2)
+
+
 def format_duration(seconds: float) -> str:
     """Seconds as H:MM:SS or M:SS."""
     seconds = max(0, int(round(seconds)))

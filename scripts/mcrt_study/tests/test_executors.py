@@ -110,7 +110,8 @@ def sequential_rows(settings, scene) -> list[dict]:
                     rows.append({"scene": scene.name, "strategy": config.strategy,
                                  "integrator": config.integrator, "sampler": config.sampler,
                                  "max_depth": depth, "spp": spp, "seed": seed, "seconds": seconds, **errors,
-                                 "family": "", "family_param": None, "light_solid_angle": scene.light_solid_angle})
+                                 "family": "", "family_param": None, "light_solid_angle": scene.light_solid_angle,
+                                 "light_select": "default"})
     return rows
 
 
@@ -252,7 +253,7 @@ class SameRowsTest(ExecutorTestCase):
 def point_row(spp: int, seed: int, seconds: float = 1.0, scene: str = "s") -> dict:
     return {"scene": scene, "strategy": "area", "integrator": "nee", "sampler": "sobol", "max_depth": 1,
             "spp": spp, "seed": seed, "seconds": seconds, "rmse": 0.5, "mse": 0.25, "relmse": 0.125,
-            "family": "", "family_param": None, "light_solid_angle": 0.25}
+            "family": "", "family_param": None, "light_solid_angle": 0.25, "light_select": "default"}
 
 
 class PointFilesTest(ExecutorTestCase):
@@ -432,7 +433,8 @@ class ByValueTest(ExecutorTestCase):
         self.assertEqual(read_points(self.tmp / "points"),
                          [("k1", {"scene": scene.name, "strategy": "area", "integrator": "nee", "sampler": "sobol",
                                   "max_depth": 1, "spp": 8, "seed": 2, "seconds": seconds, **errors,
-                                  "family": "", "family_param": None, "light_solid_angle": 0.5})])
+                                  "family": "", "family_param": None, "light_solid_angle": 0.5,
+                                  "light_select": "default"})])
         # Pickled the ordinary way (by reference), the same call needs the package.
         plain = subprocess.run([sys.executable, "-I", "-c", UNPICKLE], capture_output=True, cwd=self.tmp,
                                input=pickle.dumps(PickledCall(run_point, (task, fake_measure))), timeout=60)

@@ -347,8 +347,9 @@ class CsvColumnsTest(unittest.TestCase):
             write_csv(path, [row, {**row, "scene": "distance_h3", "family": "distance", "family_param": 3.0,
                                    "light_solid_angle": 0.0877}])
             text = path.read_text(encoding="utf-8").splitlines()
-            self.assertTrue(text[1].endswith(",,,"), text[1])
-            self.assertTrue(text[2].endswith(",distance,3,0.0877"), text[2])
+            self.assertTrue(text[1].endswith(",,,,default"), text[1])
+            self.assertTrue(text[2].endswith(",distance,3,0.0877,default"), text[2])
+            row["light_select"] = "default"
             self.assertEqual(read_csv(path, lambda name: 50), [row, {**row, "scene": "distance_h3", "family": "distance",
                                                                      "family_param": 3.0, "light_solid_angle": 0.0877}])
 
