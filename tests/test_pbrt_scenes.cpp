@@ -210,7 +210,9 @@ AttributeEnd
 
 // A disk of radius 0.5 at height 0.8: pbrt's +z normal turned by Rotate 90
 // about x to face down.
+// Its default strategy (area) and `auto` (the rule with its fixed v_rest).
 TEST_P(PbrtFloor, DiskTurnedToFaceDown) {
+  for (const std::optional<light_sampling> st : {std::optional<light_sampling>(), std::optional(light_sampling::automatic)}) {
   const pbrt::built_scene b = from_text(floor_scene(R"(
 AttributeBegin
   Translate 0 0.8 0
@@ -219,15 +221,19 @@ AttributeBegin
   Material "diffuse" "rgb reflectance" [ 0 0 0 ]
   Shape "disk" "float radius" 0.5
 AttributeEnd
-)"));
-  int id = 20;
+)"), "", st);
+  EXPECT_EQ(strategy_of(b.world.lights.at(0)), st.value_or(light_sampling::area));
+  int id = st ? 120 : 20;
   for (const float d : {0.0f, 0.3f, 0.6f, 2.0f})
     check(floor_radiance(b.world, GetParam(), d, 0.0f, id++), albedo / std::numbers::pi * test::disk_irradiance(0.8, d, 0.5, emit),
-          "disk at d=" + std::to_string(d));
+          "disk at d=" + std::to_string(d) + (st ? " (auto)" : ""));
+  }
 }
 
-// A sphere of radius 0.35 (a unit sphere scaled) at (0.1, 0.9, -0.05).
+// A sphere of radius 0.35 (a unit sphere scaled) at (0.1, 0.9, -0.05);
+// its default strategy (the cone) and `auto`.
 TEST_P(PbrtFloor, SphereScaledAndMoved) {
+  for (const std::optional<light_sampling> st : {std::optional<light_sampling>(), std::optional(light_sampling::automatic)}) {
   const pbrt::built_scene b = from_text(floor_scene(R"(
 AttributeBegin
   Translate 0.1 0.9 -0.05
@@ -236,7 +242,8 @@ AttributeBegin
   Material "diffuse" "rgb reflectance" [ 0 0 0 ]
   Shape "sphere"
 AttributeEnd
-)"));
+)"), "", st);
+  EXPECT_EQ(strategy_of(b.world.lights.at(0)), st.value_or(light_sampling::solid_angle));
   const auto& spheres = std::get<std::vector<object<sphere>>>(b.world.objects);
   ASSERT_EQ(spheres.size(), 1u);
   const glm::dvec3 c(spheres[0].shape.center);
@@ -244,11 +251,13 @@ AttributeEnd
   EXPECT_LT(glm::length(c - glm::dvec3(0.1, 0.9, -0.05)), 1e-6);
   EXPECT_NEAR(r, 0.35, 1e-6);
   EXPECT_FALSE(spheres[0].shape.flip);
-  int id = 30;
+  int id = st ? 130 : 30;
   for (const auto& [x, z] : floor_points) {
     const glm::dvec3 w = c - glm::dvec3(x, 0.0, z);
     const double d2 = glm::dot(w, w);
-    check(floor_radiance(b.world, GetParam(), x, z, id++), albedo * emit * (r * r / d2) * (w.y / std::sqrt(d2)), "sphere");
+    check(floor_radiance(b.world, GetParam(), x, z, id++), albedo * emit * (r * r / d2) * (w.y / std::sqrt(d2)),
+          st ? "sphere (auto)" : "sphere");
+  }
   }
 }
 
@@ -279,7 +288,8 @@ TEST_P(PbrtTriangleStrategies, MatchLambertOneAndTwoSided) {
 INSTANTIATE_TEST_SUITE_P(All, PbrtTriangleStrategies,
                          ::testing::Combine(::testing::Values(light_sampling::area, light_sampling::solid_angle,
                                                               light_sampling::projected_solid_angle,
-                                                              light_sampling::bilinear_solid_angle, light_sampling::pbrt),
+                                                              light_sampling::bilinear_solid_angle, light_sampling::pbrt,
+                                                              light_sampling::automatic),
                                             ::testing::Values(integrator_kind::mixture, integrator_kind::nee,
                                                               integrator_kind::mis)),
                          [](const ::testing::TestParamInfo<TriangleStrategyCase>& info) {

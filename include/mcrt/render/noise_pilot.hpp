@@ -91,15 +91,15 @@ namespace mcrt {
 
 struct noise_pilot_settings {
   int pixels = 1024;       // about this many pixels of the image (all, for smaller images)
+  int spp = 2;             // samples per pixel (>= 2: a sample variance needs two)
+  int emission_rays = 8;   // K: camera rays per measured pixel, spread over the finer blocks, for the
+                           // variance of what they meet first (header; < 2: none)
   // Each light's own noise is measured where the scene has at most this
   // many lights (its cost grows with their number: two samples of every
   // light at each pixel); beyond, light_variance is 0 and `auto`'s rule
   // takes the light's share of the noise from its model alone
   // (render/choice_gain_pilot.hpp).
   std::size_t light_noise_limit = 256;
-  int spp = 2;             // samples per pixel (>= 2: a sample variance needs two)
-  int emission_rays = 8;   // K: camera rays per measured pixel, spread over the finer blocks, for the
-                           // variance of what they meet first (header; < 2: none)
 };
 
 // A scene that counts the rays traced in it (its hit tests) and otherwise is
