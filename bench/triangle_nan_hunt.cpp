@@ -8,9 +8,12 @@
 // pdf() of the direction returned. Counts per strategy: samples returned,
 // NaN or infinite directions, distances or pdfs, returned pdfs that are not
 // positive, and returned directions whose pdf() is 0 (directions that miss
-// the triangle once rounded to float). Seeded: the same N and seed give
-// the same counts. Prints a markdown table; exit status 1 if any NaN or
-// infinity was met.
+// the triangle once rounded to float), the last also by the observer's
+// height over the triangle's plane in decades of its size (where float
+// directions miss: observers all but in the plane, whose directions graze
+// it, so that a direction's rounding moves its hit point by more than the
+// triangle's size). Seeded: the same N and seed give the same counts.
+// Prints markdown tables; exit status 1 if any NaN or infinity was met.
 //
 //   build/mcrt_triangle_nan_hunt [N] [seed] [strategies: sa,psa,bilinear,pbrt,area]
 #include <chrono>
@@ -35,13 +38,18 @@ namespace {
 
 using namespace mcrt;
 
+// Decades of the observer's height / the triangle's size: 1e-7 .. 1e3.
+constexpr int decades = 10, lowest_decade = -7;
+
 struct counts {
   std::uint64_t draws = 0, returned = 0, nonfinite = 0, bad_pdf = 0, zero_pdf_of_returned = 0;
+  std::uint64_t returned_by[decades] = {}, zero_by[decades] = {};
 };
 
 struct configuration {
   triangle t;
   vec3 o, n;
+  int decade = 0;  // of height / size
 };
 
 vec3 unit_vector(pcg32& rng) {
@@ -64,7 +72,8 @@ configuration random_configuration(pcg32& rng) {
   m->indices = {0, 1, 2};
   configuration c{triangle{m, 0}, vec3(0.0f), vec3(0.0f)};
   const vec3 nrm = c.t.normal();
-  const float height = size * std::pow(10.0f, -7.0f + 10.0f * rng.uniform());
+  const float exponent = -7.0f + 10.0f * rng.uniform();
+  const float height = size * std::pow(10.0f, exponent);
   vec3 foot;
   if (rng.uniform() < 0.5f) {
     const vec2 b = square_to_triangle(rng.uniform2());
@@ -73,6 +82,7 @@ configuration random_configuration(pcg32& rng) {
     foot = centre + (rng.uniform() - 0.5f) * 4.0f * size * u + (rng.uniform() - 0.5f) * 4.0f * size * v;
   }
   c.o = foot + height * nrm;
+  c.decade = std::clamp(int(std::floor(exponent)) - lowest_decade, 0, decades - 1);
   // A receiver normal uniform on the hemisphere towards the light.
   vec3 d = unit_vector(rng);
   if (glm::dot(d, centre - c.o) < 0.0f) d = -d;
@@ -88,6 +98,7 @@ void draw(const Sampler& s, const configuration& c, vec2 u, counts& k) {
   // strategies that use it.
   if (!mcrt::sample(s, c.o, c.n, u, ls)) return;
   ++k.returned;
+  ++k.returned_by[c.decade];
   if (!std::isfinite(ls.pdf) || !all_finite(ls.dir) || !std::isfinite(ls.dist)) {
     ++k.nonfinite;
     return;
@@ -95,7 +106,7 @@ void draw(const Sampler& s, const configuration& c, vec2 u, counts& k) {
   if (!(ls.pdf > 0.0f)) ++k.bad_pdf;
   const float p = mcrt::pdf(s, c.o, c.n, ls.dir);
   if (!std::isfinite(p)) ++k.nonfinite;
-  if (p == 0.0f) ++k.zero_pdf_of_returned;
+  if (p == 0.0f) ++k.zero_pdf_of_returned, ++k.zero_by[c.decade];
 }
 
 }  // namespace
@@ -146,6 +157,24 @@ int main(int argc, char** argv) {
   row("bilinear-solid-angle", bil);
   row("pbrt", pb);
   row("area", area);
+  std::printf("\nShare of returned directions whose pdf() is 0, by the observer's height over the plane / the "
+              "triangle's size:\n\n| strategy |");
+  for (int d = 0; d < decades; ++d) std::printf(" 1e%d-1e%d |", d + lowest_decade, d + lowest_decade + 1);
+  std::printf("\n|---|");
+  for (int d = 0; d < decades; ++d) std::printf("---:|");
+  std::printf("\n");
+  const auto shares = [](const char* name, const counts& k) {
+    if (k.draws == 0) return;
+    std::printf("| %s |", name);
+    for (int d = 0; d < decades; ++d)
+      std::printf(" %.3g %% |", k.returned_by[d] ? 100.0 * double(k.zero_by[d]) / double(k.returned_by[d]) : 0.0);
+    std::printf("\n");
+  };
+  shares("solid-angle", sa);
+  shares("projected-solid-angle", psa);
+  shares("bilinear-solid-angle", bil);
+  shares("pbrt", pb);
+  shares("area", area);
   std::printf("\n%llu samples per strategy, seed %llu, %.1f s\n", (unsigned long long)n, (unsigned long long)seed, secs);
   return sa.nonfinite + psa.nonfinite + bil.nonfinite + pb.nonfinite + area.nonfinite == 0 ? 0 : 1;
 }
