@@ -659,10 +659,7 @@ class planar_rule {
   // that is the choice; otherwise the fine rule decides.
   light_sampling choose(const vec3& o, const vec3& n, const auto_params& p) const {
     const auto_costs::shape_costs& c = costs_;
-    float v_delta, omega_delta;
-    if (delta_v_area(o, n, v_delta, omega_delta) &&
-        auto_choice::area_wins(2.0f * v_delta, p.rest_variance_at(omega_delta), c, p))
-      return light_sampling::area;
+    if (first_test_takes_area(o, n, p)) return light_sampling::area;
     if (coarse(o, n).area_wins_even_if(4.0f, c, p)) return light_sampling::area;
     return fine(o, n).choose(c, p);
   }
