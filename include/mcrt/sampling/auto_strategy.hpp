@@ -57,6 +57,7 @@
 // does not pay at the surfaces the image sees, the light takes its
 // cheapest strategy everywhere (auto_sampler::table_gain).
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <span>
 #include <tuple>
@@ -475,8 +476,14 @@ class planar_rule {
   // d = p - o, so v_area ~ k ((grad log g . E1)^2 + (grad log g . E2)^2)
   // with grad log g = n / (n . d) - 4 d / r^2. Valid (true, with v_area)
   // only where each part of the gradient changes log g by at most 0.3
-  // across the light, so that the first-order term is all that matters
-  // (within a factor 2 on the test receivers: tests/test_auto_strategy.cpp).
+  // across the light, and so does the second-order term of -4 log r
+  // (-2 log(1 + |s|^2 / r^2) ~ -2 |s|^2 / r^2 at offset s, at most
+  // (|E1|^2 + |E2|^2) / (2 r^2) at a corner), so that the first-order term
+  // is all that matters (within a factor 2 on the test receivers:
+  // tests/test_auto_strategy.cpp). Without the second-order test a light
+  // long against its distance passes where the gradient vanishes (right
+  // under a sliver's middle, ModelVariancesLongSliver), and area sampling
+  // would be taken at v_area ~ 0 where it is ~1.
   // One division: the gradient's parts over the common denominator
   // (n . d) r^2. omega_proj: the light's area times g at its centre.
   bool delta_v_area(const vec3& o, const vec3& n, float& v_area) const {
@@ -491,7 +498,8 @@ class planar_rule {
     if (!(nd > 0.0f) || !(r2 > 0.0f)) return false;
     const float n1 = glm::dot(n, E1_), n2 = glm::dot(n, E2_);
     const float d1 = 4.0f * glm::dot(d, E1_), d2 = 4.0f * glm::dot(d, E2_);
-    if (!(0.5f * (std::abs(n1) + std::abs(n2)) <= 0.3f * nd) || !(0.5f * (std::abs(d1) + std::abs(d2)) <= 0.3f * r2))
+    if (!(0.5f * (std::abs(n1) + std::abs(n2)) <= 0.3f * nd) || !(0.5f * (std::abs(d1) + std::abs(d2)) <= 0.3f * r2) ||
+        !(0.5f * (glm::dot(E1_, E1_) + glm::dot(E2_, E2_)) <= 0.3f * r2))
       return false;
     const float inv = 1.0f / (nd * r2);
     const float g1 = (n1 * r2 - d1 * nd) * inv, g2 = (n2 * r2 - d2 * nd) * inv;
@@ -633,20 +641,87 @@ class planar_rule {
       return -a * a * c6 / 6.0 + 2.0 * a * b * cos4_sin2 + b * b * (c6 / 6.0 - c4 / 4.0);
     };
     double i1 = 0.0, i2 = 0.0;
-    const double dphi = span / angles;
-    for (int k = 0; k < angles; ++k) {
-      const double phi = phi0 + (k + 0.5) * dphi, dx = std::cos(phi), dy = std::sin(phi);
+    // The integrals along the ray from F in direction (dx, dy), weighted.
+    const auto ray = [&](double dx, double dy, double weight) {
       double r0, r1;
-      if (!chord(dx, dy, r0, r1)) continue;
+      if (!chord(dx, dy, r0, r1)) return;
       const double b = nx * dx + ny * dy;
       // cos(theta) = R cos(u - delta) > 0 for |u - delta| < pi / 2.
       const double delta = std::atan2(b, a);
       const double u0 = std::max(std::atan2(r0, h), delta - 0.5 * std::numbers::pi);
       const double u1e = std::min(std::atan2(r1, h), delta + 0.5 * std::numbers::pi);
-      if (!(u1e > u0)) continue;
-      i1 += F1(b, u1e) - F1(b, u0), i2 += F2(b, u1e) - F2(b, u0);
+      if (!(u1e > u0)) return;
+      i1 += weight * (F1(b, u1e) - F1(b, u0)), i2 += weight * (F2(b, u1e) - F2(b, u0));
+    };
+    if (kind_ == kind::triangle) {
+      // A triangle: phi parametrised by the point P(s) = A + s (B - A) of
+      // an edge, dphi = |(P - F) x (B - A)| / |P - F|^2 ds, with 6
+      // Gauss-Legendre points per piece (in tau, below). The pieces: the sectors
+      // between the directions to consecutive vertices (each swept by that
+      // edge; all three where F is on the triangle, the two about the
+      // middle vertex's direction otherwise), each split where the
+      // receiver's horizon crosses the plane (b = 0, the integrands' kink).
+      // Midpoints in phi would miss a sliver's long chords: seen from F
+      // on a sliver of aspect 100 they fill a few hundredths of a radian
+      // about its far vertices, between two of 12 angles (v_area 10-15x
+      // too large; in s they are the edge's length: ModelVariancesLongSliver).
+      constexpr double gx[3] = {0.2386191860831969, 0.6612093864662645, 0.9324695142031521};
+      constexpr double gw[3] = {0.4679139345726910, 0.3607615730481386, 0.1713244923791704};
+      const glm::dvec2 F(fx, fy), hz(-ny, nx);  // hz: the horizon's direction in the plane
+      const auto piece = [&](const glm::dvec2& A, const glm::dvec2& B, double s0, double s1) {
+        // In s the points would be as sparse near o as far from it (a
+        // sliver's edge 30 times o's height long: 6 points 5 heights apart,
+        // the peak between them); in tau = atan((s - s_F) / c), c = sqrt(h^2
+        // + d^2) / |B - A| (s_F and d the foot of F on the edge's line and
+        // F's distance to it), the angle along the edge as o sees it, the
+        // integrand is smooth: s = s_F + c tan(tau), ds = c (1 + tan^2) dtau.
+        const glm::dvec2 e = B - A;
+        const double ee = glm::dot(e, e);
+        if (!(ee > 0.0)) return;
+        const double sf = glm::dot(F - A, e) / ee, dist = std::abs((F - A).x * e.y - (F - A).y * e.x) / std::sqrt(ee);
+        const double c = std::sqrt((h * h + dist * dist) / ee);
+        const double t0 = std::atan((s0 - sf) / c), t1 = std::atan((s1 - sf) / c);
+        for (int k = 0; k < 6; ++k) {
+          const double x = (k & 1) ? gx[k / 2] : -gx[k / 2], w = gw[k / 2];
+          const double tau = 0.5 * (t0 + t1) + 0.5 * (t1 - t0) * x, tn = std::tan(tau);
+          const double sk = sf + c * tn, ds = 0.5 * (t1 - t0) * w * c * (1.0 + tn * tn);
+          const glm::dvec2 d = A + sk * e - F;
+          const double d2 = glm::dot(d, d);
+          if (!(d2 > 0.0)) continue;
+          ray(d.x / std::sqrt(d2), d.y / std::sqrt(d2), ds * std::abs(d.x * e.y - d.y * e.x) / d2);
+        }
+      };
+      const auto edge = [&](const glm::dvec2& A, const glm::dvec2& B) {
+        // s where P(s) - F is along the horizon: (A - F + s e) x hz = 0.
+        const glm::dvec2 e = B - A, q = A - F;
+        const double den = e.x * hz.y - e.y * hz.x, sh = den != 0.0 ? -(q.x * hz.y - q.y * hz.x) / den : -1.0;
+        if (sh > 0.0 && sh < 1.0) piece(A, B, 0.0, sh), piece(A, B, sh, 1.0);
+        else piece(A, B, 0.0, 1.0);
+      };
+      const glm::dvec2 V[3] = {glm::dvec2(tri_[0]), glm::dvec2(tri_[1]), glm::dvec2(tri_[2])};
+      if (inside) {
+        for (int k = 0; k < 3; ++k) edge(V[k], V[(k + 1) % 3]);
+      } else {
+        // The middle vertex: the one whose direction lies between the others'.
+        const double c = std::atan2(-fy, -fx);
+        double t[3];
+        for (int k = 0; k < 3; ++k) {
+          t[k] = std::atan2(V[k].y - fy, V[k].x - fx) - c;
+          if (t[k] > std::numbers::pi) t[k] -= 2.0 * std::numbers::pi;
+          if (t[k] < -std::numbers::pi) t[k] += 2.0 * std::numbers::pi;
+        }
+        int m = 0;
+        for (int k = 0; k < 3; ++k)
+          if ((t[k] - t[(k + 1) % 3]) * (t[k] - t[(k + 2) % 3]) <= 0.0) m = k;
+        edge(V[m], V[(m + 1) % 3]), edge(V[m], V[(m + 2) % 3]);
+      }
+    } else {
+      const double dphi = span / angles;
+      for (int k = 0; k < angles; ++k) {
+        const double phi = phi0 + (k + 0.5) * dphi;
+        ray(std::cos(phi), std::sin(phi), dphi);
+      }
     }
-    i1 *= dphi, i2 *= dphi;
     if (omega_proj) *omega_proj = i1;
     if (!(i1 > 0.0)) return 0.0;
     return std::max(double(area_) * i2 / (h * h * i1 * i1) - 1.0, 0.0);
