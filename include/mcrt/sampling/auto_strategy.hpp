@@ -61,6 +61,7 @@
 #include <limits>
 #include <span>
 #include <tuple>
+#include <utility>
 #include <variant>
 #include <vector>
 #if defined(__SSE2__)
@@ -137,6 +138,9 @@ struct auto_params {
 struct auto_costs {
   struct shape_costs {
     float area, solid_angle, projected_solid_angle;
+    float of(light_sampling s) const {
+      return s == light_sampling::area ? area : s == light_sampling::solid_angle ? solid_angle : projected_solid_angle;
+    }
   };
   static constexpr shape_costs rect{17.0f, 135.0f, 800.0f};
   static constexpr shape_costs ellipse{31.0f, 763.0f, 1700.0f};
@@ -260,6 +264,27 @@ class auto_choice {
     return peaked() ? std::max(v, (g_peak_ / mean - 1.0f) * (1.0f / 3.0f)) : v;
   }
   bool peaked() const { return g_peak_ > 2.0f * sg_; }
+  // What the BSDF's samples add to a light's estimate with mis (power
+  // heuristic, cosine-weighted BSDF sampling), whatever the light's
+  // strategy, relative: exact where the light sample's density is
+  // proportional to the BSDF's (projected solid angle: p_l = cos /
+  // Omega_proj, p_b = cos / pi, so the light sample's weighted value is a
+  // constant, and the BSDF's sample is a Bernoulli that meets the light
+  // with probability 1 / k, k = pi / Omega_proj, and then carries pi L /
+  // (k^2 + 1)): pi^2 k (1 - 1 / k) / (k^2 + 1)^2, 0.39 for a light filling
+  // half the projected hemisphere, ~pi^2 / k^3 for a small one. The
+  // strategies' own v (v_of) leave it out: it is nearly the same for each
+  // and cancels from the choice at a point, but it bounds how far a choice
+  // can lower the light's noise (render/choice_gain_pilot.hpp).
+  float v_bsdf_mis() const {
+    if (!(omega_proj_ > 0.0f)) return 0.0f;
+    const float k = std::max(pi / omega_proj_, 1.0f), k2 = k * k;
+    return pi * pi * k * (1.0f - 1.0f / k) / ((k2 + 1.0f) * (k2 + 1.0f));
+  }
+  // The modelled relative variance of strategy s (projected solid angle's is 0).
+  float v_of(light_sampling s) const {
+    return s == light_sampling::area ? v_area() : s == light_sampling::solid_angle ? v_solid_angle() : 0.0f;
+  }
   float v_solid_angle() const {
     if (!(swc_ > 0.0f)) return 0.0f;
     return excess_ratio(sw_, swc2_, swc_);
@@ -1038,6 +1063,14 @@ class tabulated_planar_rule {
            m.score_of(choose(o, n), auto_costs::table_lookup, c, params_);
   }
   light_sampling cheapest() const { return auto_choice::cheapest(rule_.costs()); }
+  // The fine model m's choice under params p (the cheapest where cheapest_only):
+  // its modelled noise D^2 v / V (this rule's V) and cost (ns).
+  std::pair<float, float> modelled(const auto_choice& m, const vec3&, const vec3&, const auto_params& p,
+                                   bool cheapest_only) const {
+    const auto_costs::shape_costs& c = rule_.costs();
+    const light_sampling s = cheapest_only ? auto_choice::cheapest(c) : m.choose(c, p);
+    return {m.v_of(s) / m.rest_variance(params_), c.of(s)};
+  }
   // Whether the rule's first test takes area sampling (the cheapest) at
   // every receiver: auto_sampler::cheapest_at_every. Triangles only (the
   // lights of meshes, often many; a rectangle's or an ellipse's gate is
@@ -1088,6 +1121,12 @@ class tabulated_sphere_rule {
   }
   // The same above the horizon and across it.
   light_sampling cheapest() const { return auto_choice::cheapest(auto_costs::sphere_for(true, params_)); }
+  std::pair<float, float> modelled(const auto_choice& m, const vec3& o, const vec3& n, const auto_params& p,
+                                   bool cheapest_only) const {
+    const auto_costs::shape_costs& c = auto_costs::sphere_for(sphere_above_horizon(sphere_, o, n), p);
+    const light_sampling s = cheapest_only ? cheapest() : m.choose(c, p);
+    return {m.v_of(s) / m.rest_variance(params_), c.of(s)};
+  }
   // No screen for spheres (their rule is a lookup of two numbers).
   bool cheapest_at_every(std::span<const auto_receiver>) const { return false; }
   // As tabulated_planar_rule::noise_share, with the cone (v_sa).
@@ -1200,6 +1239,34 @@ struct auto_sampler {
     double sum = 0.0;
     for (const auto_choice& m : models) sum += rule_.noise_share(m);
     return static_cast<float>(sum / double(models.size()));
+  }
+  // The mean over the models' receivers of D^2 v_bsdf_mis / V (this
+  // light's V, as noise_share): the BSDF samples' part of its noise with
+  // mis (0 with nee, whose light samples are all of it).
+  double mis_floor(std::span<const auto_choice> models) const {
+    if (params.pdf_with_sample || models.empty()) return 0.0;
+    double sum = 0.0;
+    for (const auto_choice& m : models) {
+      const double x = m.v_bsdf_mis() / m.rest_variance(params);
+      sum += std::isfinite(x) ? x : 0.0;
+    }
+    return sum / double(models.size());
+  }
+  // Means over rs of the modelled noise and cost under p (render/choice_gain_pilot.hpp).
+  struct totals {
+    double noise = 0.0, cost = 0.0;
+  };
+  totals modelled_totals(std::span<const auto_receiver> rs, std::span<const auto_choice> models, const auto_params& p,
+                         bool cheapest_only) const {
+    totals t;
+    if (rs.empty()) return t;
+    for (std::size_t i = 0; i < rs.size(); ++i) {
+      const auto [noise, cost] = rule_.modelled(models[i], rs[i].p, rs[i].n, p, cheapest_only);
+      t.noise += std::isfinite(noise) ? noise : 0.0;
+      t.cost += cost;
+    }
+    t.noise /= double(rs.size()), t.cost /= double(rs.size());
+    return t;
   }
   // Its sample (the choice's, where the choice is the cheapest strategy).
   bool sample_cheapest(const vec3& o, vec2 u, light_sample& s) const {
