@@ -156,7 +156,8 @@ int run_render(const render_options& opt) {
     // Each light's rule at the fixed point of the image's noise and time
     // its choice makes, and the gate of its choice (render/choice_gain_pilot.hpp).
     const auto settle_start = std::chrono::steady_clock::now();
-    settlements = settle_auto_lights(ls.world, *noise, !opt.auto_rest_cost);
+    settlements = settle_auto_lights(ls.world, cam, rs, *noise, choice_gain_pixels_for(rs.width, rs.height),
+                                     !opt.auto_rest_cost);
     for (const auto_light_settlement& a : settlements)
       if (a.cheapest) ls.auto_cheapest_lights.push_back(static_cast<std::uint32_t>(a.light));
     settle_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - settle_start).count();
@@ -216,6 +217,8 @@ int run_render(const render_options& opt) {
       nlohmann::ordered_json lights = nlohmann::ordered_json::array();
       for (const auto_light_settlement& a : settlements)
         lights.push_back({{"light", a.light},
+                          {"gain_factor", a.kappa},
+                          {"gain_factor_first_bounce", a.kappa_first_bounce},
                           {"noise_share", a.noise_share},
                           {"noise_share_measured", a.noise_share_measured},
                           {"noise_share_model", a.noise_share_model},
@@ -223,7 +226,8 @@ int run_render(const render_options& opt) {
                           {"rest_cost", a.rest_cost},
                           {"rest_noise", a.rest_noise},
                           {"fixed_point_steps", a.fixed_point_steps},
-                          {"cheapest", a.cheapest}});
+                          {"cheapest", a.cheapest},
+                          {"gain_factor_seconds", a.kappa_seconds}});
       j["auto_lights"] = lights;
     }
     write_text(opt.stats, j.dump(2) + "\n");

@@ -44,7 +44,23 @@
 // 5x the image's noise under a sliver of aspect 10, 0.15x solid angle's
 // efficiency). Where the rest is not reduced alike (deep bounces of global
 // light), the choice is weighed against less noise than the image has.
+//
+// With nee there is no BSDF floor: a light's samples are all of its
+// estimate, s clamped to 1 leaves R = 0, and the fixed point took
+// projected solid angle everywhere over a floor at 0.3 light sizes (0.45x
+// the first-order rule's efficiency: there the image's noise is mostly not
+// the light's, which the sequence removes far better than the rest). nee
+// keeps the first-order rule, with kappa, what the image's samples leave
+// of the choice's gain, measured per light (choice_gain_factor):
+//   kappa = sum_x w_x N Var_m(mean of d) / sum_x w_x Var(d of one sample),
+// d = f_c - f_a the light's estimates with the cheapest strategy and the
+// choice from the same point of the square, at up to `pixels` of the
+// pilot's pixels where the choice is dearer (evenly spaced), M = 2
+// scramblings of the image's samples, N = spp each; kappa = f kappa_1 + (1
+// - f) over a path's light samples (f the first bounce's share); V_l = V
+// (1 - (1 - kappa) s) / kappa, the rest left at its independent size.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -53,11 +69,59 @@
 #include <variant>
 #include <vector>
 
+#include "mcrt/render/camera.hpp"
 #include "mcrt/render/light.hpp"
 #include "mcrt/render/noise_pilot.hpp"
+#include "mcrt/render/renderer.hpp"
 #include "mcrt/render/rest_cost.hpp"
+#include "mcrt/samplers/independent.hpp"
+#include "mcrt/samplers/layout.hpp"
+#include "mcrt/samplers/samplers.hpp"
 
 namespace mcrt {
+
+// The pilot `mcrt render` runs: at most W H / 300 pixels (at least 32, at
+// most 256) with 2 scramblings each of the image's samples; each camera
+// sample a camera ray, two light samples and two shadow rays (about 1.5 %
+// of the image's samples' time with direct light).
+inline int choice_gain_pixels_for(int width, int height) {
+  return static_cast<int>(std::clamp(static_cast<double>(width) * height / 300.0, 32.0, 256.0));
+}
+
+// kappa (header) of the auto light s at the pixels given, for M =
+// scramblings sets of samples of type Sampler (seeded from `seed`); 1 where
+// the difference never varies (no pixel, or the two strategies agree).
+template <class Sampler, class Scene, class Auto>
+double choice_gain_factor_with(const Scene& sc, const camera& cam, const render_settings& rs, const Auto& s,
+                               std::span<const edge_pixel> pixels, std::uint64_t seed, int scramblings = 2) {
+  const float inv_w = 1.0f / static_cast<float>(rs.width), inv_h = 1.0f / static_cast<float>(rs.height);
+  constexpr int dim = layout::bounce(0) + layout::light;
+  // d at one camera sample: 0 where its ray meets no diffuse surface.
+  return sequence_noise_factor<Sampler>(rs, pixels, seed, scramblings, [&](auto& px, int x, int y) {
+    hit_record rec;
+    if (!sc.hit(camera_ray(cam, px, x, y, inv_w, inv_h), 0.0f, infinity, rec)) return 0.0;
+    const auto* lam = std::get_if<lambertian>(&sc.materials[rec.material]);
+    if (!lam) return 0.0;
+    const vec3 nf = rec.facing_normal();
+    const vec3 p = rec.spawn_origin(nf);
+    const vec2 u = px.get2d(dim);
+    light_sample lc, la;
+    const double fc = light_estimate(sc, s.sample_cheapest(p, u, lc), lc, p, nf);
+    const double fa = light_estimate(sc, s.sample(p, nf, u, la), la, p, nf);
+    return (double(lam->albedo.r) + lam->albedo.g + lam->albedo.b) / 3.0 * inv_pi * (fc - fa);
+  }, 1024);  // two light samples and shadow rays each: about 250 ns
+}
+
+// With the image's sample generator (rs.sampler); 1 for independent samples.
+template <class Scene, class Auto>
+double choice_gain_factor(const Scene& sc, const camera& cam, const render_settings& rs, const Auto& s,
+                          std::span<const edge_pixel> pixels, int scramblings = 2) {
+  if (rs.sampler == sampler_kind::independent || pixels.empty()) return 1.0;
+  // Their own seeds ("gainq" and j): not the image's scramblings.
+  return with_sampler(rs.sampler, [&]<class S>() {
+    return choice_gain_factor_with<S>(sc, cam, rs, s, pixels, rs.seed ^ 0x6761696e71ull, scramblings);
+  });
+}
 
 // The fixed point of a light's V_l and c_rest (header), from V, its noise
 // share s, R and c_rest; p holds V_l and c_rest on entry (V and c_rest)
@@ -84,6 +148,9 @@ int settle_fixed_point(const Auto& s, std::span<const auto_receiver> rs, std::sp
 // What settle_auto_lights found for one light sampled by `auto`.
 struct auto_light_settlement {
   std::size_t light = 0;        // index in the scene's lights
+  double kappa = 1.0;           // nee: what the image's samples leave of the choice's gain (header)
+  double kappa_first_bounce = 1.0;  // of which at the first bounce's light samples
+  double kappa_seconds = 0.0;   // the time its measurement took (0 where it was not measured)
   double noise_share = 0.0;     // s: the light's own noise with its cheapest strategy, over V
   double noise_share_measured = 0.0, noise_share_model = 0.0;
   double rest_noise = 0.0;      // R: the image's noise beyond the light's (header)
@@ -101,7 +168,8 @@ struct auto_light_settlement {
 // Triangles whose rule's first test takes area sampling at every receiver
 // get it without the models (auto_sampler::cheapest_at_every).
 template <class Scene>
-std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const noise_pilot_result& noise,
+std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& cam, const render_settings& rs,
+                                                      const noise_pilot_result& noise, int pixels,
                                                       bool model_rest_cost = true) {
   std::vector<auto_light_settlement> out;
   for (std::size_t i = 0; i < sc.lights.size(); ++i) {
@@ -135,6 +203,35 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const noise_pil
             a.noise_share_model = s.noise_share(models);
             const double reflected = v > 0.0 ? std::clamp(1.0 - noise.edge_variance / v, 0.0, 1.0) : 1.0;
             a.noise_share = std::clamp(std::max(measured, a.noise_share_model), 0.0, reflected);
+            if (p.pdf_with_sample) {
+              // nee (header): the first-order rule with kappa measured, where
+              // the choice pays with V.
+              if (!(with_cost.table_gain(noise.receivers, models) > 0.0f)) {
+                rebuilt = with_cost;
+                return;
+              }
+              std::vector<edge_pixel> dearer;
+              for (std::size_t k = 0; k < noise.receivers.size(); ++k)
+                if (with_cost.choice(noise.receivers[k].p, noise.receivers[k].n) != s.cheapest())
+                  dearer.push_back(noise.receiver_pixels[k]);
+              const std::vector<edge_pixel> chosen = evenly_spaced(dearer, pixels);
+              // Measured on the first bounce's light samples; at deeper
+              // bounces the sequence leaves about all of the light's noise,
+              // so over a path's light samples kappa is the first bounce's
+              // share of them times kappa plus the rest.
+              const auto kappa_start = std::chrono::steady_clock::now();
+              a.kappa_first_bounce = choice_gain_factor(sc, cam, rs, with_cost, chosen);
+              a.kappa_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - kappa_start).count();
+              const double f = std::clamp(noise.first_bounce_share, 0.0, 1.0);
+              a.kappa = f * a.kappa_first_bounce + (1.0 - f);
+              a.rest_noise = v * (1.0 - a.noise_share);
+              a.image_variance = a.kappa > 0.0 ? v * (1.0 - (1.0 - a.kappa) * a.noise_share) / a.kappa
+                                               : double(std::numeric_limits<float>::max());
+              p.image_variance =
+                  static_cast<float>(std::min(a.image_variance, double(std::numeric_limits<float>::max())));
+              rebuilt = s.with_params(p);
+              return;
+            }
             a.rest_noise = v * std::max(1.0 - a.noise_share, s.mis_floor(models));
             a.fixed_point_steps = settle_fixed_point(s, noise.receivers, models, v, a.noise_share, a.rest_noise,
                                                      a.rest_cost, p);
