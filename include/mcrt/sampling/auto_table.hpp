@@ -19,13 +19,21 @@
 // twice the lateral cells. Lateral |x| / (|x| + s_i) in [0, 1) (x / (|x| +
 // s_i) in (-1, 1) without the symmetry) with s_i the light's half
 // extent along axis i (a rectangle's half edge, an ellipse's semi-axis, the
-// half edge of a triangle's rectangle of the same covariance), and
-// height h / (h + s_h) in [0, 1) with s_h = sqrt(s_1 s_2), so that cells are
+// half edge of a triangle's rectangle of the same covariance; at least a
+// quarter of the other one's, for slivers), and height h / (h + s_h) in
+// [0, 1) with s_h = sqrt(e_1 e_2) of the half extents, so that cells are
 // fine near the light, where the choice changes, and cover every distance
 // (far receivers share the outermost cells, where the rule's choice no
 // longer changes with distance: the variances fall as (size / distance)^2).
 // Normals: the octahedral map (Meyer et al. 2010, "On floating-point normal
-// vectors", EGSR) of n in the light's frame onto [-1, 1]^2.
+// vectors", EGSR) of n in the light's frame, its pole facing the light
+// (-n_l), onto [-1, 1]^2 in an odd number of cells, so that a receiver
+// facing the light squarely (a floor under a ceiling light, the commonest)
+// falls in the cell centred on its own normal. (With the pole at the map's
+// folded corners, the corner cells' centres were 5.7 degrees off it: under
+// a sliver of aspect 100 that tilt across its length moved the choice, and
+// the table agreed with the rule at half the floor's receivers;
+// ChoiceBesideASliver.)
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -126,7 +134,7 @@ class planar_auto_table {
   // Cells per coordinate: lateral (over the quadrant), height, and each of
   // the normal's two.
   // (Without the symmetry, 2 lateral_cells over both signs.)
-  static constexpr int lateral_cells = 16, height_cells = 16, normal_cells = 16;
+  static constexpr int lateral_cells = 16, height_cells = 16, normal_cells = 17;
   static constexpr std::size_t cell_count =
       std::size_t(lateral_cells) * lateral_cells * height_cells * normal_cells * normal_cells;
 
@@ -142,11 +150,17 @@ class planar_auto_table {
                     bool symmetric = true)
       : c_(centre), nl_(normal), symmetric_(symmetric), lateral_(symmetric ? lateral_cells : 2 * lateral_cells),
         position_cells_(std::size_t(lateral_) * lateral_ * height_cells) {
-    s1_ = glm::length(half1);
-    s2_ = glm::length(half2);
-    u1_ = half1 / s1_;
-    u2_ = half2 / s2_;
-    sh_ = std::sqrt(s1_ * s2_);
+    const float e1 = glm::length(half1), e2 = glm::length(half2);
+    u1_ = half1 / e1;
+    u2_ = half2 / e2;
+    sh_ = std::sqrt(e1 * e2);
+    // The lateral scales at least a quarter of the larger half extent: the
+    // choice changes over the light's length and the receiver's height, not
+    // over a sliver's width; at its own width a sliver's cells (aspect 100:
+    // all of |y| > 15 widths in the last cell) would hand every receiver
+    // beside it the choice at one distance (ChoiceBesideASliver).
+    s1_ = std::max(e1, 0.25f * e2);
+    s2_ = std::max(e2, 0.25f * e1);
     cells_ = lazy_choice_cells(position_cells_ * normal_cells * normal_cells, [frame = *this, choose = std::move(choose)](std::size_t i) {
       return choose(frame.cell_receiver(i), frame.cell_normal(i));
     });
@@ -163,7 +177,7 @@ class planar_auto_table {
     const float sx = symmetric_ ? std::copysign(1.0f, x0) : 1.0f, sy = symmetric_ ? std::copysign(1.0f, y0) : 1.0f;
     const float x = sx * x0, y = sy * y0;
     const float nx = sx * glm::dot(n, u1_), ny = sy * glm::dot(n, u2_);
-    const float nz = glm::dot(n, nl_);
+    const float nz = -glm::dot(n, nl_);  // > 0 facing the light: the map's centre (header)
     // The four divisions as one packed one.
     const std::array<float, 4> inv =
         fast_math::reciprocal4(std::abs(nx) + std::abs(ny) + std::abs(nz), std::abs(x) + s1_, std::abs(y) + s2_, h + sh_);
@@ -205,7 +219,7 @@ class planar_auto_table {
     const int b = int(normal % normal_cells), a = int(normal / normal_cells);
     const vec3 nloc =
         octahedral_decode(centre_of(a, normal_cells, -1.0f, 1.0f), centre_of(b, normal_cells, -1.0f, 1.0f));
-    return glm::normalize(nloc.x * u1_ + nloc.y * u2_ + nloc.z * nl_);
+    return glm::normalize(nloc.x * u1_ + nloc.y * u2_ - nloc.z * nl_);
   }
   // The cell of t in [lo, hi) cut into k (NaN and the ends clamped).
   static int cell(float t, int k, float lo, float hi) {
