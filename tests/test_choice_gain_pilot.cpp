@@ -325,11 +325,12 @@ TEST(ChoiceGainPilot, SettleWeighsEachAutoLight) {
 // The fixed point takes the choice as a whole: over a floor under a sliver
 // of aspect 100 (length 10 at height 1, tri_aspect_a100's light; direct
 // light, Sobol, 64 x 64 at 8 spp), area sampling's noise is all of the
-// pilot's V, and at V itself the rule keeps area sampling at a third or
-// more of the receivers under the light (92 of 167 dearer), although solid
-// angle there has 1/30 of its variance (ModelVariancesLongSliver). At the
-// fixed point V_l is a small part of V and the dearer strategies are taken
-// at more than 9 in 10 of them (all 167).
+// pilot's V, and at V itself the rule keeps area sampling at some of the
+// receivers under the light (139 of 167 dearer; 92 with the table's
+// normal cells before they faced the light), although solid angle there
+// has 1/30 of its variance (ModelVariancesLongSliver). At the fixed point
+// V_l is a small part of V and the dearer strategies are taken at all of
+// them.
 TEST(ChoiceGainPilot, FixedPointTakesTheChoiceAsAWhole) {
   auto mesh = std::make_shared<triangle_mesh>();
   mesh->p = {vec3(-5.0f, 1.0f, -0.0288675f), vec3(5.0f, 1.0f, -0.0288675f), vec3(0.0f, 1.0f, 0.057735f)};
@@ -366,8 +367,8 @@ TEST(ChoiceGainPilot, FixedPointTakesTheChoiceAsAWhole) {
   std::printf("under the sliver: %d receivers, dearer than area %d at V, %d at the fixed point; V_l / V %g\n", under,
               dearer_before, dearer_after, a[0].image_variance / noise.image_variance);
   ASSERT_GE(under, 20) << "the premise: receivers under the light";
-  EXPECT_LT(dearer_before, under * 2 / 3) << "the premise: at V the rule keeps area sampling at a third of them";
-  EXPECT_GT(dearer_after, under * 9 / 10);
+  EXPECT_LT(dearer_before, under) << "the premise: at V the rule keeps area sampling at some of them";
+  EXPECT_EQ(dearer_after, under);
   EXPECT_LT(a[0].image_variance, 0.5 * noise.image_variance);
 }
 
