@@ -129,16 +129,17 @@ double choice_gain_factor(const Scene& sc, const camera& cam, const render_setti
 template <class Auto>
 int settle_fixed_point(const Auto& s, std::span<const auto_receiver> rs, std::span<const auto_choice> models,
                        double v, double share, double rest_noise, float rest_cost, auto_params& p, int steps = 16) {
-  const auto base = s.modelled_totals(rs, models, p, true);
-  if (!(base.noise > 0.0) || !(v > 0.0)) return 0;
+  // With the cheapest strategy everywhere: N_0 and C_0.
+  const double base_noise = s.noise_share(models), base_cost = s.cheapest_cost();
+  if (!(base_noise > 0.0) || !(v > 0.0)) return 0;
   int k = 0;
   for (; k < steps; ++k) {
-    const auto with = s.modelled_totals(rs, models, p, false);
-    const double share_after = share * with.noise / base.noise;
+    const auto with = s.modelled_totals(rs, models, p);
+    const double share_after = share * with.noise / base_noise;
     const double vl = rest_noise + share_after * v;
     const float vf = static_cast<float>(std::clamp(vl, double(std::numeric_limits<float>::min()),
                                                    double(std::numeric_limits<float>::max())));
-    const float rest = rest_cost + static_cast<float>(with.cost - base.cost);
+    const float rest = rest_cost + static_cast<float>(with.cost - base_cost);
     if (std::abs(vf - p.image_variance) <= 1e-3f * p.image_variance && std::abs(rest - p.rest_cost) <= 0.5f) break;
     p.image_variance = vf, p.rest_cost = rest;
   }

@@ -285,6 +285,14 @@ class auto_choice {
   float v_of(light_sampling s) const {
     return s == light_sampling::area ? v_area() : s == light_sampling::solid_angle ? v_solid_angle() : 0.0f;
   }
+  // The choice under params p with costs c: its noise D^2 v / V, V the
+  // image variance of params `own` (v over own's v_rest, as noise_share),
+  // and its cost (ns).
+  std::pair<float, float> noise_and_cost(const auto_costs::shape_costs& c, const auto_params& p,
+                                         const auto_params& own) const {
+    const light_sampling s = choose(c, p);
+    return {v_of(s) / rest_variance(own), c.of(s)};
+  }
   float v_solid_angle() const {
     if (!(swc_ > 0.0f)) return 0.0f;
     return excess_ratio(sw_, swc2_, swc_);
@@ -633,18 +641,23 @@ class planar_rule {
     const bool inside = kind_ == kind::triangle ? inside_triangle(fx, fy)
                         : rect ? std::abs(fx) <= ha && std::abs(fy) <= hb
                                : (fx * fx) / (ha * ha) + (fy * fy) / (hb * hb) <= 1.0;
-    if (!inside) {
-      const double c = std::atan2(-fy, -fx);
+    // The angle of the direction from F to (px, py) from the direction to
+    // the light's centre, c, in [-pi, pi] (the light is convex and F
+    // outside it: its points lie within pi of c).
+    const double c = std::atan2(-fy, -fx);
+    const auto angle_from_centre = [&](double px, double py) {
+      double t = std::atan2(py - fy, px - fx) - c;
+      if (t > std::numbers::pi) t -= 2.0 * std::numbers::pi;
+      if (t < -std::numbers::pi) t += 2.0 * std::numbers::pi;
+      return t;
+    };
+    if (!inside && kind_ != kind::triangle) {  // a triangle's directions: by its edges, below
       double lo = 0.0, hi = 0.0;
       const auto extend = [&](double px, double py) {
-        double t = std::atan2(py - fy, px - fx) - c;
-        if (t > std::numbers::pi) t -= 2.0 * std::numbers::pi;
-        if (t < -std::numbers::pi) t += 2.0 * std::numbers::pi;
+        const double t = angle_from_centre(px, py);
         lo = std::min(lo, t), hi = std::max(hi, t);
       };
-      if (kind_ == kind::triangle) {
-        for (const vec2& t : tri_) extend(t.x, t.y);
-      } else if (rect) {
+      if (rect) {
         for (const double sx : {-1.0, 1.0})
           for (const double sy : {-1.0, 1.0}) extend(sx * ha, sy * hb);
       } else {
@@ -728,13 +741,8 @@ class planar_rule {
         for (int k = 0; k < 3; ++k) edge(V[k], V[(k + 1) % 3]);
       } else {
         // The middle vertex: the one whose direction lies between the others'.
-        const double c = std::atan2(-fy, -fx);
         double t[3];
-        for (int k = 0; k < 3; ++k) {
-          t[k] = std::atan2(V[k].y - fy, V[k].x - fx) - c;
-          if (t[k] > std::numbers::pi) t[k] -= 2.0 * std::numbers::pi;
-          if (t[k] < -std::numbers::pi) t[k] += 2.0 * std::numbers::pi;
-        }
+        for (int k = 0; k < 3; ++k) t[k] = angle_from_centre(V[k].x, V[k].y);
         int m = 0;
         for (int k = 0; k < 3; ++k)
           if ((t[k] - t[(k + 1) % 3]) * (t[k] - t[(k + 2) % 3]) <= 0.0) m = k;
@@ -1063,13 +1071,10 @@ class tabulated_planar_rule {
            m.score_of(choose(o, n), auto_costs::table_lookup, c, params_);
   }
   light_sampling cheapest() const { return auto_choice::cheapest(rule_.costs()); }
-  // The fine model m's choice under params p (the cheapest where cheapest_only):
-  // its modelled noise D^2 v / V (this rule's V) and cost (ns).
-  std::pair<float, float> modelled(const auto_choice& m, const vec3&, const vec3&, const auto_params& p,
-                                   bool cheapest_only) const {
-    const auto_costs::shape_costs& c = rule_.costs();
-    const light_sampling s = cheapest_only ? auto_choice::cheapest(c) : m.choose(c, p);
-    return {m.v_of(s) / m.rest_variance(params_), c.of(s)};
+  // The fine model m's choice under params p: its modelled noise D^2 v /
+  // V (this rule's V) and cost (ns; auto_choice::noise_and_cost).
+  std::pair<float, float> modelled(const auto_choice& m, const vec3&, const vec3&, const auto_params& p) const {
+    return m.noise_and_cost(rule_.costs(), p, params_);
   }
   // Whether the rule's first test takes area sampling (the cheapest) at
   // every receiver: auto_sampler::cheapest_at_every. Triangles only (the
@@ -1121,11 +1126,9 @@ class tabulated_sphere_rule {
   }
   // The same above the horizon and across it.
   light_sampling cheapest() const { return auto_choice::cheapest(auto_costs::sphere_for(true, params_)); }
-  std::pair<float, float> modelled(const auto_choice& m, const vec3& o, const vec3& n, const auto_params& p,
-                                   bool cheapest_only) const {
-    const auto_costs::shape_costs& c = auto_costs::sphere_for(sphere_above_horizon(sphere_, o, n), p);
-    const light_sampling s = cheapest_only ? cheapest() : m.choose(c, p);
-    return {m.v_of(s) / m.rest_variance(params_), c.of(s)};
+  // As tabulated_planar_rule::modelled, with the costs above or across the horizon.
+  std::pair<float, float> modelled(const auto_choice& m, const vec3& o, const vec3& n, const auto_params& p) const {
+    return m.noise_and_cost(auto_costs::sphere_for(sphere_above_horizon(sphere_, o, n), p), p, params_);
   }
   // No screen for spheres (their rule is a lookup of two numbers).
   bool cheapest_at_every(std::span<const auto_receiver>) const { return false; }
@@ -1252,16 +1255,18 @@ struct auto_sampler {
     }
     return sum / double(models.size());
   }
-  // Means over rs of the modelled noise and cost under p (render/choice_gain_pilot.hpp).
+  // Means over rs of the modelled noise and cost of the choice under p
+  // (render/choice_gain_pilot.hpp; with the cheapest strategy everywhere
+  // they are noise_share and cheapest_cost).
   struct totals {
     double noise = 0.0, cost = 0.0;
   };
-  totals modelled_totals(std::span<const auto_receiver> rs, std::span<const auto_choice> models, const auto_params& p,
-                         bool cheapest_only) const {
+  totals modelled_totals(std::span<const auto_receiver> rs, std::span<const auto_choice> models,
+                         const auto_params& p) const {
     totals t;
     if (rs.empty()) return t;
     for (std::size_t i = 0; i < rs.size(); ++i) {
-      const auto [noise, cost] = rule_.modelled(models[i], rs[i].p, rs[i].n, p, cheapest_only);
+      const auto [noise, cost] = rule_.modelled(models[i], rs[i].p, rs[i].n, p);
       t.noise += std::isfinite(noise) ? noise : 0.0;
       t.cost += cost;
     }
