@@ -23,10 +23,12 @@
 //          RTC_BUILD_QUALITY_MEDIUM (its default) and HIGH (spatial splits),
 //          on a device of one thread ("threads=1") and on its default
 //          device (TBB, every core).
-//   closest: mcrt's bvh::closest with the watertight triangle test on the
-//          vertices in leaf order ("bare"), basic_scene::hit (the hit record
-//          of the closest hit included: "scene"), against rtcIntersect1.
-//   shadow: bvh::any (first hit ends the traversal) against rtcOccluded1.
+//   closest: mcrt's bvh::closest_leaf with the watertight test of a leaf's
+//          triangles at once (geometry/triangle_leaf.hpp) on the vertices in
+//          leaf order ("bare"), basic_scene::hit (the hit record of the
+//          closest hit included: "scene"), against rtcIntersect1.
+//   shadow: bvh::any_leaf (first hit ends the traversal) against
+//          rtcOccluded1.
 // Embree's scenes are built with its default flags (its fast, not watertight
 // triangle test) and, for MEDIUM, also RTC_SCENE_FLAG_ROBUST.
 // Cross-check: hit or miss, t and triangle of every closest-hit ray, blocked
@@ -149,40 +151,44 @@ vec3 point_in(const aabb& b, pcg32& rng) {
 
 struct mcrt_bare {
   bvh tree;
-  std::vector<std::uint32_t> triangle_of;       // leaf order -> the mesh's triangle
+  std::vector<std::uint32_t> triangle_of;  // leaf order -> the mesh's triangle
   // the vertices in leaf order (in huge pages where the system has them)
-  std::vector<std::array<vec3, 3>, large_array_allocator<std::array<vec3, 3>>> verts;
+  std::vector<triangle_vertices, large_array_allocator<triangle_vertices>> verts;
 
   explicit mcrt_bare(const triangle_mesh& m) {
     const std::size_t n = m.triangle_count();
     std::vector<aabb> bounds(n);
     for (std::size_t i = 0; i < n; ++i)
       for (int k = 0; k < 3; ++k) bounds[i].grow(m.p[m.indices[3 * i + std::size_t(k)]]);
-    tree = bvh(bounds);
+    tree = bvh(bounds, triangle_leaf_width);
     triangle_of = tree.order();
     verts.resize(n);
-    for (std::size_t k = 0; k < n; ++k)
-      for (int v = 0; v < 3; ++v) verts[k][std::size_t(v)] = m.p[m.indices[3 * std::size_t(triangle_of[k]) + std::size_t(v)]];
+    for (std::size_t k = 0; k < n; ++k) {
+      for (int v = 0; v < 3; ++v)
+        verts[k].p[std::size_t(v)] = m.p[m.indices[3 * std::size_t(triangle_of[k]) + std::size_t(v)]];
+      verts[k].tag = triangle_of[k];
+    }
     tree.renumber_in_order();
   }
 
   // t of the closest hit (infinity for none); prim its triangle.
   float closest(const ray& r, std::int64_t& prim) const {
     float tmax = infinity;
-    const std::int64_t k = tree.closest(r, 0.0f, tmax, [&](std::uint32_t slot, float t0, float t1) -> float {
-      const std::array<vec3, 3>& v = verts[slot];
-      const std::optional<triangle_hit> h = intersect_triangle(r, t1, v[0], v[1], v[2]);
-      return h && h->t > t0 && h->t < t1 ? h->t : infinity;
-    });
-    prim = k < 0 ? -1 : std::int64_t(triangle_of[std::size_t(k)]);
+    const watertight_ray wr(r);
+    triangle_hit h;
+    const std::int64_t k =
+        tree.closest_leaf(r, 0.0f, tmax, [&](std::uint32_t first, std::uint32_t count, float t0, float& t1) {
+          const int j = closest_in_leaf(wr, t0, t1, &verts[first], int(count), h);
+          return j < 0 ? std::int64_t(-1) : std::int64_t(first) + j;
+        });
+    prim = k < 0 ? -1 : std::int64_t(verts[std::size_t(k)].tag);
     return k < 0 ? infinity : tmax;
   }
 
   bool occluded(const ray& r, float tmax) const {
-    return tree.any(r, 0.0f, tmax, [&](std::uint32_t slot, float t0, float t1) {
-      const std::array<vec3, 3>& v = verts[slot];
-      const std::optional<triangle_hit> h = intersect_triangle(r, t1, v[0], v[1], v[2]);
-      return h && h->t > t0 && h->t < t1;
+    const watertight_ray wr(r);
+    return tree.any_leaf(r, 0.0f, tmax, [&](std::uint32_t first, std::uint32_t count, float t0, float t1) {
+      return any_in_leaf(wr, t0, t1, &verts[first], int(count));
     });
   }
 };

@@ -18,6 +18,7 @@
 #include "mcrt/accel/bvh.hpp"
 #include "mcrt/render/scene.hpp"
 #include "mcrt/core/rng.hpp"
+#include "mcrt/geometry/triangle_leaf.hpp"
 #include "mcrt/geometry/triangle_mesh.hpp"
 #include "mcrt/sampling/warp.hpp"
 
@@ -130,16 +131,82 @@ void expect_same_as_brute_force(const soup& s, const bvh& tree, pcg32& rng, int 
   EXPECT_GT(blocked, min_blocked * rays);
 }
 
+// The leaf queries (closest_leaf, any_leaf) of a tree built with
+// leaf_block 4, its triangles copied in the leaves' order and tested a leaf
+// at a time by triangle_leaf.hpp (as the scene and the Embree bench do),
+// against brute force: the same t, and a triangle of that t.
+void expect_leaf_queries_as_brute_force(const soup& s, pcg32& rng, int rays, float extent) {
+  const std::size_t n = s.a.size();
+  bvh tree(s.bounds(), triangle_leaf_width);
+  check_tree(tree, s.bounds());
+  std::vector<triangle_vertices> tv(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::uint32_t i = tree.order()[k];
+    tv[k] = {{s.a[i], s.b[i], s.c[i]}, i};
+  }
+  tree.renumber_in_order();
+  int hits = 0;
+  for (int k = 0; k < rays; ++k) {
+    const vec3 o{(rng.uniform() - 0.5f) * 1.5f * extent, (rng.uniform() - 0.5f) * 1.5f * extent,
+                 (rng.uniform() - 0.5f) * 1.5f * extent};
+    vec3 d = square_to_uniform_sphere(rng.uniform2());
+    if (k % 2 == 1) {
+      const std::size_t i = static_cast<std::size_t>(rng.uniform() * float(n)) % n;
+      const vec3 to = (s.a[i] + s.b[i] + s.c[i]) / 3.0f - o;
+      if (glm::length(to) > 0.0f) d = glm::normalize(to);
+    }
+    if (k % 5 == 0) {
+      d = vec3(0.0f);
+      d[k % 3] = (k % 2) ? 1.0f : -1.0f;
+    }
+    const ray r{o, d};
+    float brute_t = infinity;
+    for (std::uint32_t i = 0; i < n; ++i) brute_t = std::min(brute_t, s.hit(i, r, brute_t));
+    const watertight_ray wr(r);
+    float tree_t = infinity;
+    triangle_hit h;
+    const std::int64_t slot = tree.closest_leaf(r, 0.0f, tree_t, [&](std::uint32_t first, std::uint32_t count, float t0, float& t1) {
+      EXPECT_LE(count, std::uint32_t(triangle_leaf_width));
+      const int j = closest_in_leaf(wr, t0, t1, &tv[first], int(count), h);
+      return j < 0 ? std::int64_t(-1) : std::int64_t(first) + j;
+    });
+    ASSERT_EQ(tree_t, brute_t) << "ray " << k;
+    ASSERT_EQ(slot >= 0, brute_t < infinity);
+    if (slot >= 0) {
+      EXPECT_EQ(s.hit(tv[std::size_t(slot)].tag, r, infinity), brute_t);
+      EXPECT_EQ(h.t, brute_t);
+      ++hits;
+    }
+    const float seg = rng.uniform() * 2.0f * extent;
+    bool brute_any = false;
+    for (std::uint32_t i = 0; i < n && !brute_any; ++i) brute_any = s.hit(i, r, seg) < seg;
+    const bool tree_any = tree.any_leaf(r, 0.0f, seg, [&](std::uint32_t first, std::uint32_t count, float t0, float t1) {
+      return any_in_leaf(wr, t0, t1, &tv[first], int(count));
+    });
+    ASSERT_EQ(tree_any, brute_any) << "ray " << k;
+  }
+  EXPECT_GT(hits, rays / 5);
+}
+
 }  // namespace
 
 TEST(Bvh, ClosestAndAnyHitAreThoseOfBruteForce) {
   pcg32 rng(1, 2);
-  for (const int n : {1, 2, 5, 100, 3000}) {
+  for (const int leaf_block : {1, triangle_leaf_width})
+    for (const int n : {1, 2, 5, 100, 3000}) {
+      const soup s = random_soup(rng, n, 10.0f, n > 100 ? 1.0f : 4.0f);
+      const std::vector<aabb> b = s.bounds();
+      const bvh tree(b, leaf_block);
+      check_tree(tree, b);
+      expect_same_as_brute_force(s, tree, rng, 3000, 10.0f);
+    }
+}
+
+TEST(Bvh, LeafQueriesAreThoseOfBruteForce) {
+  pcg32 rng(21, 2);
+  for (const int n : {1, 3, 4, 5, 100, 3000}) {
     const soup s = random_soup(rng, n, 10.0f, n > 100 ? 1.0f : 4.0f);
-    const std::vector<aabb> b = s.bounds();
-    const bvh tree(b);
-    check_tree(tree, b);
-    expect_same_as_brute_force(s, tree, rng, 3000, 10.0f);
+    expect_leaf_queries_as_brute_force(s, rng, 3000, 10.0f);
   }
 }
 

@@ -2,23 +2,28 @@
 // A bounding volume hierarchy over any primitives: built by the binned
 // surface area heuristic (MacDonald & Booth 1990, "Heuristics for ray
 // tracing using space subdivision"; Wald 2007, "On fast construction of
-// SAH-based bounding volume hierarchies"; pbrt-v4's BVHAggregate with 12
-// buckets), stored as compact nodes in depth-first order (32 bytes: the box,
-// the second child's or the first primitive's index, a count and the split
-// axis; Pharr et al., "Physically Based Rendering", 4th ed., sec. 7.3.4).
-// For traversal that binary tree is collapsed into an 8-wide one (Dammertz,
-// Hanika & Keller 2008, "Shallow bounding volume hierarchies for fast SIMD
-// ray tracing of incoherent rays"; Wald, Benthin & Boulos 2008, "Getting rid
-// of packets"; as Embree's BVH8): a 256-byte node holds its eight children's
-// boxes side by side, a structure of arrays tested as one 8-wide vector. A
-// ray visits the children it hits nearest first (by where it enters their
-// boxes), asks the memory ahead for the nodes it puts aside, and skips, when
-// it comes back to them, those it enters beyond its closest hit so far;
-// shadow rays stop at the first hit. On incoherent rays through a large
-// mesh the traversal waits on memory, for nodes and primitives alike: the
-// wide tree is a third as deep as the binary one (9 levels against 27 on
-// 1.29 million triangles), and its nodes live in huge pages where the
-// system offers them (large_array_allocator).
+// SAH-based bounding volume hierarchies"; pbrt-v4's BVHAggregate, with 32
+// buckets as Embree's builders), a leaf priced by the tests it takes: one
+// per primitive, or one per block of four where the caller tests a leaf's
+// triangles as one vector (leaf_block, geometry/triangle_leaf.hpp; Embree's
+// SAH block size). It is stored as compact nodes in depth-first order
+// (32 bytes: the box, the second child's or the first primitive's index, a
+// count and the split axis; Pharr et al., "Physically Based Rendering", 4th
+// ed., sec. 7.3.4). For traversal that binary tree is collapsed into an
+// 8-wide one (Dammertz, Hanika & Keller 2008, "Shallow bounding volume
+// hierarchies for fast SIMD ray tracing of incoherent rays"; Wald, Benthin
+// & Boulos 2008, "Getting rid of packets"; as Embree's BVH8): a 256-byte
+// node holds its eight children's boxes side by side, a structure of
+// arrays tested as one 8-wide vector. A ray visits the children it hits
+// nearest first (by where it enters their boxes), asks the memory for
+// every node it will visit as soon as it knows of it (the one it goes on
+// with as well as those it puts aside), and skips, when it comes back to
+// them, those it enters beyond its closest hit so far; shadow rays take the
+// children in their node's order and stop at the first hit (Embree's
+// traverseClosestHit and traverseAnyHit). On incoherent rays through a
+// large mesh the traversal waits on memory, for nodes and primitives
+// alike: the wide tree is a third as deep as the binary one, and its nodes
+// live in huge pages where the system offers them (large_array_allocator).
 //
 // The hierarchy knows its primitives only through their bounds, at build
 // time, and through a callback at traversal: it holds their order, so a
@@ -103,8 +108,12 @@ class bvh {
 
   bvh() = default;
 
-  // Builds over primitives 0 .. bounds.size() - 1.
-  explicit bvh(const std::vector<aabb>& bounds) {
+  // Builds over primitives 0 .. bounds.size() - 1. leaf_block: how many
+  // primitives the caller's leaf test takes at the price of one (1: one by
+  // one; 4: a vector test of a leaf's triangles, geometry/triangle_leaf.hpp),
+  // by which the surface area heuristic prices a leaf (ceil(n / leaf_block)
+  // tests, Embree's SAH block size).
+  explicit bvh(const std::vector<aabb>& bounds, int leaf_block = 1) : leaf_block_(std::clamp(leaf_block, 1, max_leaf_size)) {
     order_.resize(bounds.size());
     for (std::size_t i = 0; i < bounds.size(); ++i) order_[i] = static_cast<std::uint32_t>(i);
     if (bounds.empty()) return;
@@ -133,6 +142,34 @@ class bvh {
     in_order_ = true;
   }
 
+  // The closest hit in (tmin, tmax), a leaf at a time: hit_leaf(first,
+  // count, tmin, tmax) tests the primitives at places first .. first +
+  // count - 1 of order() (after renumber_in_order, the caller's own places:
+  // a leaf's primitives lie side by side), lowers tmax to the closest hit
+  // it finds before tmax and returns that primitive's place, or -1.
+  // Returns the place of the closest hit, or -1.
+  template <class HitLeaf>
+  std::int64_t closest_leaf(const ray& r, float tmin, float& tmax, HitLeaf&& hit_leaf) const {
+    std::int64_t best = -1;
+    traverse(r, tmin, tmax, [&](std::uint32_t first, std::uint32_t count, float& t_max) {
+      const std::int64_t k = hit_leaf(first, count, tmin, t_max);
+      if (k >= 0) best = k;
+      return false;
+    });
+    return best;
+  }
+
+  // Whether any primitive is hit in (tmin, tmax), a leaf at a time:
+  // any_leaf(first, count, tmin, tmax) returns true for a hit among the
+  // places first .. first + count - 1 of order(); the traversal stops at
+  // the first.
+  template <class AnyLeaf>
+  bool any_leaf(const ray& r, float tmin, float tmax, AnyLeaf&& any_leaf) const {
+    return traverse<true>(r, tmin, tmax, [&](std::uint32_t first, std::uint32_t count, float& t_max) {
+      return any_leaf(first, count, tmin, t_max);
+    });
+  }
+
   // The closest hit in (tmin, tmax): hit(i, tmin, tmax) tests primitive i
   // and returns its hit's t, or a value >= tmax (infinity) for none; tmax
   // is lowered to each hit found. Returns the primitive of the closest hit,
@@ -140,11 +177,14 @@ class bvh {
   template <class Hit>
   std::int64_t closest(const ray& r, float tmin, float& tmax, Hit&& hit) const {
     std::int64_t best = -1;
-    traverse(r, tmin, tmax, [&](std::uint32_t prim, float& t_max) {
-      const float t = hit(prim, tmin, t_max);
-      if (t < t_max) {
-        t_max = t;
-        best = prim;
+    traverse(r, tmin, tmax, [&](std::uint32_t first, std::uint32_t count, float& t_max) {
+      for (std::uint32_t i = 0; i < count; ++i) {
+        const std::uint32_t prim = primitive(first + i);
+        const float t = hit(prim, tmin, t_max);
+        if (t < t_max) {
+          t_max = t;
+          best = prim;
+        }
       }
       return false;
     });
@@ -155,7 +195,11 @@ class bvh {
   // true for a hit; the traversal stops at the first.
   template <class Hit>
   bool any(const ray& r, float tmin, float tmax, Hit&& hit) const {
-    return traverse(r, tmin, tmax, [&](std::uint32_t prim, float& t_max) { return hit(prim, tmin, t_max); });
+    return traverse<true>(r, tmin, tmax, [&](std::uint32_t first, std::uint32_t count, float& t_max) {
+      for (std::uint32_t i = 0; i < count; ++i)
+        if (hit(primitive(first + i), tmin, t_max)) return true;
+      return false;
+    });
   }
 
  private:
@@ -171,16 +215,20 @@ class bvh {
   };
   static_assert(sizeof(wide_node) == 32 * width);
 
+  // The primitive at place k of order().
+  std::uint32_t primitive(std::uint32_t k) const { return in_order_ ? k : order_[k]; }
+
   std::vector<node> nodes_;
   std::vector<wide_node, large_array_allocator<wide_node>> wide_;
   std::vector<std::uint32_t> order_;
   bool in_order_ = false;  // order_ is the identity (renumber_in_order)
+  int leaf_block_ = 1;     // the primitives a leaf test takes at once (the constructor)
   std::vector<char> leaf_;  // while collapsing: which binary nodes become leaves
   // The most entries the traversal's stack can hold on this tree: on a path
   // from the root, each node's children but one (collapse_node's bound).
   std::uint32_t stack_bound_ = 0;
 
-  static constexpr int bucket_count = 12;
+  static constexpr int bucket_count = 32;
   // The traversal's stack holds at most one node per level. Below this depth
   // the build halves by count, so no tree is deeper than it plus log2 of the
   // primitive count (<= 32): within the stack.
@@ -220,12 +268,16 @@ class bvh {
       // Every centroid in one place (no split separates them), or deep enough
       // that the tree must stay within the traversal's stack: halves by count.
       if (n <= static_cast<std::uint32_t>(max_leaf_size)) return make_leaf();
-    } else if (n <= 2) {
+    } else if (n <= 2 && leaf_block_ == 1) {
       std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
                        [&](std::uint32_t a, std::uint32_t b) { return centroids[a][axis] < centroids[b][axis]; });
     } else {
       // Binned SAH: cost of a split after bucket k, relative cost of a
-      // traversal step 1/2 as pbrt-v4 (leaf cost = primitives).
+      // traversal step 1/2 as pbrt-v4 (leaf cost = its tests, primitives
+      // in blocks of leaf_block_).
+      const auto tests = [&](std::uint32_t count) {
+        return float((count + static_cast<std::uint32_t>(leaf_block_) - 1) / static_cast<std::uint32_t>(leaf_block_));
+      };
       std::array<aabb, bucket_count> bucket_box;
       std::array<std::uint32_t, bucket_count> bucket_n{};
       const auto bucket_of = [&](std::uint32_t prim) {
@@ -243,19 +295,19 @@ class bvh {
       for (int k = 0; k < bucket_count - 1; ++k) {
         below.grow(bucket_box[static_cast<std::size_t>(k)]);
         count_below += bucket_n[static_cast<std::size_t>(k)];
-        cost[static_cast<std::size_t>(k)] = float(count_below) * below.surface_area();
+        cost[static_cast<std::size_t>(k)] = tests(count_below) * below.surface_area();
       }
       aabb above;
       std::uint32_t count_above = 0;
       for (int k = bucket_count - 1; k >= 1; --k) {
         above.grow(bucket_box[static_cast<std::size_t>(k)]);
         count_above += bucket_n[static_cast<std::size_t>(k)];
-        cost[static_cast<std::size_t>(k - 1)] += float(count_above) * above.surface_area();
+        cost[static_cast<std::size_t>(k - 1)] += tests(count_above) * above.surface_area();
       }
       int best = 0;
       for (int k = 1; k < bucket_count - 1; ++k)
         if (cost[static_cast<std::size_t>(k)] < cost[static_cast<std::size_t>(best)]) best = k;
-      const float leaf_cost = float(n);
+      const float leaf_cost = tests(n);
       const float split_cost = 0.5f + cost[static_cast<std::size_t>(best)] / box.surface_area();
       if (n <= static_cast<std::uint32_t>(max_leaf_size) && !(split_cost < leaf_cost)) return make_leaf();
       const auto* split = std::partition(order_.data() + begin, order_.data() + end,
@@ -380,34 +432,55 @@ class bvh {
     return index;
   }
 
-  // The slab test of a ray against a node's eight boxes, with the far
-  // distance widened by 2 gamma(3) so that rounding cannot reject a box the
-  // ray grazes (PBRT 4th ed., sec. 6.8.2): bit i of the result for child i,
-  // t0[i] where the ray enters its box. A NaN distance (0 * inf, a ray in a
-  // slab's plane) leaves the interval as it is.
-  static unsigned hits_boxes(const wide_node& w, const vec3& o, const vec3& inv_d,
-                             const std::array<std::size_t, 3>& near_row, const std::array<std::size_t, 3>& far_row,
-                             float tmin, float tmax, std::array<float, width>& t0) {
-    constexpr float widen = 1.0f + 2.0f * rounding_gamma(3);
+  // What the slab tests of one ray share: for each axis, the origin's
+  // coordinate, the reciprocal direction, the reciprocal widened by
+  // 1 + 2 gamma(3) for the far planes (so that rounding cannot reject a
+  // box the ray grazes, PBRT 4th ed., sec. 6.8.2: fl(fl(p - o) fl(w / d))
+  // takes as many roundings as pbrt's fl(fl(fl(p - o) / d) w)), and the
+  // rows of a node's boxes that hold the axis's near and far planes.
+  struct ray_slabs {
+    std::array<float, 3> o, inv, inv_far;
+    std::array<std::size_t, 3> near_row, far_row;
+    explicit ray_slabs(const ray& r) {
+      constexpr float widen = 1.0f + 2.0f * rounding_gamma(3);
+      for (int a = 0; a < 3; ++a) {
+        const auto u = static_cast<std::size_t>(a);
+        o[u] = r.o[a];
+        inv[u] = 1.0f / r.d[a];
+        inv_far[u] = inv[u] * widen;
+        const bool neg = inv[u] < 0.0f;
+        near_row[u] = static_cast<std::size_t>(neg ? a + 3 : a);
+        far_row[u] = static_cast<std::size_t>(neg ? a : a + 3);
+      }
+    }
+  };
+
+  // The slab test of a ray against a node's eight boxes: bit i of the
+  // result for child i, t0[i] where the ray enters its box. A NaN distance
+  // (0 * inf, a ray in a slab's plane) never narrows the interval.
+  static unsigned hits_boxes(const wide_node& w, const ray_slabs& rs, float tmin, float tmax,
+                             std::array<float, width>& t0) {
 #if defined(__GNUC__) || defined(__clang__)
     // Every lane at once (GCC's and Clang's vector extensions: AVX, or
     // pairs of SSE or NEON vectors).
     using floatw = float __attribute__((vector_size(4 * width)));
-    using intw = std::int32_t __attribute__((vector_size(4 * width)));
-    floatw lo = floatw{} + tmin, hi = floatw{} + tmax;
+    std::array<floatw, 3> near, far;
     for (std::size_t a = 0; a < 3; ++a) {
       floatw near_plane, far_plane;
-      std::memcpy(&near_plane, w.b[near_row[a]].data(), sizeof(floatw));
-      std::memcpy(&far_plane, w.b[far_row[a]].data(), sizeof(floatw));
-      const float oa = o[static_cast<int>(a)], ia = inv_d[static_cast<int>(a)];
-      const floatw near = (near_plane - oa) * ia;
-      const floatw far = (far_plane - oa) * ia * widen;
-      const intw n = near > lo, f = far < hi;
-      lo = reinterpret_cast<floatw>((reinterpret_cast<intw>(near) & n) | (reinterpret_cast<intw>(lo) & ~n));
-      hi = reinterpret_cast<floatw>((reinterpret_cast<intw>(far) & f) | (reinterpret_cast<intw>(hi) & ~f));
+      std::memcpy(&near_plane, w.b[rs.near_row[a]].data(), sizeof(floatw));
+      std::memcpy(&far_plane, w.b[rs.far_row[a]].data(), sizeof(floatw));
+      near[a] = (near_plane - rs.o[a]) * rs.inv[a];
+      far[a] = (far_plane - rs.o[a]) * rs.inv_far[a];
     }
-    const intw in = lo <= hi;
+    // max(x, y) = x > y ? x : y, so a NaN in x leaves y; as a tree of two
+    // levels (a NaN in y may then drop x too: the interval only widens, and
+    // no box the ray meets is lost).
+    const auto max = [](floatw x, floatw y) { return x > y ? x : y; };
+    const auto min = [](floatw x, floatw y) { return x < y ? x : y; };
+    const floatw lo = max(max(near[0], near[1]), max(near[2], floatw{} + tmin));
+    const floatw hi = min(min(far[0], far[1]), min(far[2], floatw{} + tmax));
     std::memcpy(t0.data(), &lo, sizeof(floatw));
+    const auto in = lo <= hi;
 #if defined(__AVX__)
     if constexpr (width == 8) return static_cast<unsigned>(__builtin_ia32_movmskps256(reinterpret_cast<floatw>(in)));
 #endif
@@ -419,11 +492,10 @@ class bvh {
     t0.fill(tmin);
     t1.fill(tmax);
     for (std::size_t a = 0; a < 3; ++a) {
-      const std::array<float, width>&near_plane = w.b[near_row[a]], &far_plane = w.b[far_row[a]];
-      const float oa = o[static_cast<int>(a)], ia = inv_d[static_cast<int>(a)];
+      const std::array<float, width>&near_plane = w.b[rs.near_row[a]], &far_plane = w.b[rs.far_row[a]];
       for (std::size_t i = 0; i < width; ++i) {
-        const float near = (near_plane[i] - oa) * ia;
-        const float far = (far_plane[i] - oa) * ia * widen;
+        const float near = (near_plane[i] - rs.o[a]) * rs.inv[a];
+        const float far = (far_plane[i] - rs.o[a]) * rs.inv_far[a];
         t0[i] = near > t0[i] ? near : t0[i];
         t1[i] = far < t1[i] ? far : t1[i];
       }
@@ -443,26 +515,23 @@ class bvh {
 #endif
   }
 
-  // Visits the leaves' primitives front to back; visit(prim, tmax) may
-  // lower tmax and returns true to stop.
-  template <class Visit>
+  // Visits the leaves front to back; visit(first, count, tmax), for the
+  // places first .. first + count - 1 of order(), may lower tmax and
+  // returns true to stop. AnyHit: a query that stops at the first hit and
+  // never lowers tmax, for which the order of the visits does not matter:
+  // the children are taken in their node's order, unsorted (Embree's
+  // traverseAnyHit).
+  template <bool AnyHit = false, class Visit>
   bool traverse(const ray& r, float tmin, float& tmax, Visit&& visit) const {
     if (wide_.empty()) return false;
     if (stack_bound_ <= static_cast<std::uint32_t>(small_stack_size))
-      return traverse_with<small_stack_size>(r, tmin, tmax, visit);
-    return traverse_with<wide_stack_size>(r, tmin, tmax, visit);
+      return traverse_with<small_stack_size, AnyHit>(r, tmin, tmax, visit);
+    return traverse_with<wide_stack_size, AnyHit>(r, tmin, tmax, visit);
   }
 
-  template <int StackSize, class Visit>
+  template <int StackSize, bool AnyHit, class Visit>
   bool traverse_with(const ray& r, float tmin, float& tmax, Visit& visit) const {
-    const vec3 inv_d = 1.0f / r.d;
-    // The rows of a node's boxes that hold each axis's near and far planes.
-    std::array<std::size_t, 3> near_row, far_row;
-    for (int a = 0; a < 3; ++a) {
-      const bool neg = inv_d[a] < 0.0f;
-      near_row[static_cast<std::size_t>(a)] = static_cast<std::size_t>(neg ? a + 3 : a);
-      far_row[static_cast<std::size_t>(a)] = static_cast<std::size_t>(neg ? a : a + 3);
-    }
+    const ray_slabs rs(r);
     struct entry {
       std::uint32_t child;
       std::uint32_t count;  // leaf: its primitives; 0: a wide node
@@ -470,47 +539,78 @@ class bvh {
     };
     std::array<entry, StackSize> stack;
     int top = 0;
+    // A child the traversal goes on with, or puts aside, has its node asked
+    // for at once: the memory is on its way while the rest of this node is
+    // dealt with.
+    const auto ask = [&](const entry& c) {
+      if (c.count == 0) prefetch(&wide_[c.child]);
+      return c;
+    };
     entry e{0, 0, tmin};
     while (true) {
       if (e.count > 0) {
-        for (std::uint32_t i = 0; i < e.count; ++i)
-          if (visit(in_order_ ? e.child + i : order_[e.child + i], tmax)) return true;
+        if (visit(e.child, e.count, tmax)) return true;
       } else {
         const wide_node& w = wide_[e.child];
         std::array<float, width> t0;
-        unsigned mask = hits_boxes(w, r.o, inv_d, near_row, far_row, tmin, tmax, t0);
+        unsigned mask = hits_boxes(w, rs, tmin, tmax, t0);
         if (mask != 0) {
-          const auto child = [&](unsigned i) { return entry{w.child[i], w.count[i], t0[i]}; };
-          const auto first = static_cast<unsigned>(std::countr_zero(mask));
+          const auto child = [&](unsigned i) { return ask(entry{w.child[i], w.count[i], t0[i]}); };
+          const entry a = child(static_cast<unsigned>(std::countr_zero(mask)));
           mask &= mask - 1;
           if (mask == 0) {  // one child hit: on to it
-            e = child(first);
+            e = a;
             continue;
           }
-          // Several: onto the stack, sorted so that the nearest is on top,
-          // and on to it; the others wait, their nodes asked for ahead.
-          const int base = top;
-          stack[static_cast<std::size_t>(top++)] = child(first);
-          do {
-            const entry c = child(static_cast<unsigned>(std::countr_zero(mask)));
+          if constexpr (AnyHit) {
+            // The first on, the others onto the stack as they come.
+            e = a;
+            do {
+              stack[static_cast<std::size_t>(top++)] = child(static_cast<unsigned>(std::countr_zero(mask)));
+              mask &= mask - 1;
+            } while (mask != 0);
+            continue;
+          } else {
+            const entry b = child(static_cast<unsigned>(std::countr_zero(mask)));
             mask &= mask - 1;
-            int k = top++;
-            for (; k > base && stack[static_cast<std::size_t>(k - 1)].t < c.t; --k)
-              stack[static_cast<std::size_t>(k)] = stack[static_cast<std::size_t>(k - 1)];
-            stack[static_cast<std::size_t>(k)] = c;
-          } while (mask != 0);
-          e = stack[static_cast<std::size_t>(--top)];
-          for (int k = base; k < top; ++k)
-            if (stack[static_cast<std::size_t>(k)].count == 0) prefetch(&wide_[stack[static_cast<std::size_t>(k)].child]);
-          continue;
+            if (mask == 0) {  // two: on to the nearer, the other waits
+              const bool a_first = a.t <= b.t;
+              stack[static_cast<std::size_t>(top++)] = a_first ? b : a;
+              e = a_first ? a : b;
+              continue;
+            }
+            // More: onto the stack, sorted so that the nearest is on top,
+            // and on to it.
+            const int base = top;
+            const auto insert = [&](const entry& c) {
+              int k = top++;
+              for (; k > base && stack[static_cast<std::size_t>(k - 1)].t < c.t; --k)
+                stack[static_cast<std::size_t>(k)] = stack[static_cast<std::size_t>(k - 1)];
+              stack[static_cast<std::size_t>(k)] = c;
+            };
+            insert(a);
+            insert(b);
+            do {
+              insert(child(static_cast<unsigned>(std::countr_zero(mask))));
+              mask &= mask - 1;
+            } while (mask != 0);
+            e = stack[static_cast<std::size_t>(--top)];
+            continue;
+          }
         }
       }
-      // The next waiting child that the ray enters before its closest hit
-      // so far.
-      do {
+      if constexpr (AnyHit) {
+        // Every waiting child is entered before tmax, which never falls.
         if (top == 0) return false;
         e = stack[static_cast<std::size_t>(--top)];
-      } while (e.t > tmax);
+      } else {
+        // The next waiting child that the ray enters before its closest hit
+        // so far.
+        do {
+          if (top == 0) return false;
+          e = stack[static_cast<std::size_t>(--top)];
+        } while (e.t > tmax);
+      }
     }
   }
 };

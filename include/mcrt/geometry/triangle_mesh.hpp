@@ -65,34 +65,54 @@ inline vec3 permute(const vec3& v, int x, int y, int z) { return {v[x], v[y], v[
 // in (0, tmax); t must exceed the bound of its own rounding (PBRT 4th ed.,
 // sec. 6.8.7), so a ray leaving the triangle's surface never meets it at t
 // ~ 0.
-inline std::optional<triangle_hit> intersect_triangle(const ray& r, float tmax, const vec3& p0, const vec3& p1,
-                                                      const vec3& p2) {
-  // Degenerate triangles (zero area) are never hit.
-  const vec3 c = glm::cross(p2 - p0, p1 - p0);
-  if (glm::dot(c, c) == 0.0f) return std::nullopt;
-  vec3 p0t = p0 - r.o, p1t = p1 - r.o, p2t = p2 - r.o;
-  const int kz = detail::max_dimension(glm::abs(r.d));
-  const int kx = kz == 2 ? 0 : kz + 1, ky = kx == 2 ? 0 : kx + 1;
-  const vec3 d = detail::permute(r.d, kx, ky, kz);
-  p0t = detail::permute(p0t, kx, ky, kz);
-  p1t = detail::permute(p1t, kx, ky, kz);
-  p2t = detail::permute(p2t, kx, ky, kz);
-  // Shear so that the ray runs along +z (z is scaled later, only where the
-  // test passes).
-  const float sx = -d.x / d.z, sy = -d.y / d.z, sz = 1.0f / d.z;
-  p0t.x += sx * p0t.z;
-  p0t.y += sy * p0t.z;
-  p1t.x += sx * p1t.z;
-  p1t.y += sy * p1t.z;
-  p2t.x += sx * p2t.z;
-  p2t.y += sy * p2t.z;
+//
+// The ray's part of that frame (the permutation and the shear, sec. 3's
+// per-ray precomputation) is set up once per ray: a traversal tests many
+// triangles with one watertight_ray.
+struct watertight_ray {
+  vec3 o;
+  int kx = 0, ky = 1, kz = 2;  // d's largest component becomes z
+  float sx = 0.0f, sy = 0.0f, sz = 1.0f;
+
+  explicit watertight_ray(const ray& r) : o(r.o) {
+    const vec3 a = glm::abs(r.d);
+    kz = detail::max_dimension(a);
+    kx = kz == 2 ? 0 : kz + 1;
+    ky = kx == 2 ? 0 : kx + 1;
+    const float dx = component(r.d, kx), dy = component(r.d, ky), dz = component(r.d, kz);
+    // Shear so that the ray runs along +z (z is scaled later, only where the
+    // test passes).
+    sx = -dx / dz;
+    sy = -dy / dz;
+    sz = 1.0f / dz;
+  }
+
+  // v's component k (glm's operator[] takes a branch per call).
+  static float component(const vec3& v, int k) { return (&v.x)[k]; }
+
+  // p - o in the permuted, sheared frame (z not yet scaled). The shear's
+  // products are fused (one rounding each) whatever the compiler's
+  // contraction, so that a vector test over several triangles computes
+  // the same numbers (triangle_leaf.hpp).
+  vec3 to_frame(const vec3& p) const {
+    const float x = component(p, kx) - component(o, kx);
+    const float y = component(p, ky) - component(o, ky);
+    const float z = component(p, kz) - component(o, kz);
+    return {std::fma(sx, z, x), std::fma(sy, z, y), z};
+  }
+};
+static_assert(sizeof(float[3]) == sizeof(vec3), "watertight_ray::component reads a vec3 as three floats");
+
+inline std::optional<triangle_hit> intersect_triangle(const watertight_ray& wr, float tmax, const vec3& p0,
+                                                      const vec3& p1, const vec3& p2) {
+  vec3 p0t = wr.to_frame(p0), p1t = wr.to_frame(p1), p2t = wr.to_frame(p2);
   // Edge functions (twice the signed areas of the sub-triangles the origin
   // makes); a zero may be the rounding of a tiny value of either sign, so
   // it is recomputed in double.
   float e0 = detail::difference_of_products(p1t.x, p2t.y, p1t.y, p2t.x);
   float e1 = detail::difference_of_products(p2t.x, p0t.y, p2t.y, p0t.x);
   float e2 = detail::difference_of_products(p0t.x, p1t.y, p0t.y, p1t.x);
-  if (e0 == 0.0f || e1 == 0.0f || e2 == 0.0f) {
+  if (e0 == 0.0f || e1 == 0.0f || e2 == 0.0f) [[unlikely]] {
     e0 = static_cast<float>(double(p1t.x) * double(p2t.y) - double(p1t.y) * double(p2t.x));
     e1 = static_cast<float>(double(p2t.x) * double(p0t.y) - double(p2t.y) * double(p0t.x));
     e2 = static_cast<float>(double(p0t.x) * double(p1t.y) - double(p0t.y) * double(p1t.x));
@@ -101,12 +121,16 @@ inline std::optional<triangle_hit> intersect_triangle(const ray& r, float tmax, 
   const float det = e0 + e1 + e2;
   if (det == 0.0f) return std::nullopt;
   // The scaled hit distance, compared with 0 and tmax before the division.
-  p0t.z *= sz;
-  p1t.z *= sz;
-  p2t.z *= sz;
-  const float t_scaled = e0 * p0t.z + e1 * p1t.z + e2 * p2t.z;
+  p0t.z *= wr.sz;
+  p1t.z *= wr.sz;
+  p2t.z *= wr.sz;
+  const float t_scaled = std::fma(e2, p2t.z, std::fma(e1, p1t.z, e0 * p0t.z));
   if (det < 0.0f && (t_scaled >= 0.0f || t_scaled < tmax * det)) return std::nullopt;
   if (det > 0.0f && (t_scaled <= 0.0f || t_scaled > tmax * det)) return std::nullopt;
+  // Degenerate triangles (zero area) are never hit (tested here, where few
+  // triangles arrive, rather than first).
+  const vec3 c = glm::cross(p2 - p0, p1 - p0);
+  if (glm::dot(c, c) == 0.0f) return std::nullopt;
   const float inv_det = 1.0f / det;
   const triangle_hit h{t_scaled * inv_det, e0 * inv_det, e1 * inv_det, e2 * inv_det};
   // t conservatively above 0: the bound of its rounding (PBRT 4th ed., eqs.
@@ -124,6 +148,12 @@ inline std::optional<triangle_hit> intersect_triangle(const ray& r, float tmax, 
       3.0f * (rounding_gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * std::abs(inv_det);
   if (!(h.t > delta_t)) return std::nullopt;
   return h;
+}
+
+// The same for one ray and one triangle.
+inline std::optional<triangle_hit> intersect_triangle(const ray& r, float tmax, const vec3& p0, const vec3& p1,
+                                                      const vec3& p2) {
+  return intersect_triangle(watertight_ray(r), tmax, p0, p1, p2);
 }
 
 // One triangle of a mesh, as a shape of the scene.

@@ -19,6 +19,7 @@
 #include "mcrt/geometry/ellipse.hpp"
 #include "mcrt/geometry/rect.hpp"
 #include "mcrt/geometry/sphere.hpp"
+#include "mcrt/geometry/triangle_leaf.hpp"
 #include "mcrt/geometry/triangle_mesh.hpp"
 #include "mcrt/materials/material.hpp"
 #include "mcrt/render/light.hpp"
@@ -127,17 +128,26 @@ struct basic_scene {
           }(),
           ...);
     }(std::index_sequence_for<Shapes...>{});
-    accel_ = bvh(bounds);
-    // The shapes in the leaves' order, a triangle's vertices beside its
-    // reference: a leaf's tests read adjacent memory.
+    // Triangles are tested a leaf at a time, four at once
+    // (geometry/triangle_leaf.hpp): their leaves are priced so.
+    std::size_t triangles = 0;
+    if constexpr (has_triangles) triangles = std::get<triangle_type>(objects).size();
+    accel_ = bvh(bounds, triangles > 0 ? triangle_leaf_width : 1);
+    // The shapes in the leaves' order; a triangle's vertices (and its index
+    // among the triangles) at its place: a leaf's tests read adjacent
+    // memory, and a triangle's test reads nothing else.
     prims_.resize(refs.size());
-    if constexpr (has_triangles) tri_verts_.resize(refs.size());
+    if (triangles > 0) tri_verts_.resize(refs.size());
     for (std::size_t k = 0; k < refs.size(); ++k) {
       prims_[k] = refs[accel_.order()[k]];
       if constexpr (has_triangles)
-        if (prims_[k].type == triangle_type) {
-          const triangle& t = std::get<triangle_type>(objects)[prims_[k].object].shape;
-          tri_verts_[k] = {t.vertex(0), t.vertex(1), t.vertex(2)};
+        if (triangles > 0) {
+          if (prims_[k].type == triangle_type) {
+            const triangle& t = std::get<triangle_type>(objects)[prims_[k].object].shape;
+            tri_verts_[k] = {{t.vertex(0), t.vertex(1), t.vertex(2)}, prims_[k].object};
+          } else {
+            tri_verts_[k] = {{vec3(0.0f), vec3(0.0f), vec3(0.0f)}, not_a_triangle};
+          }
         }
     }
     accel_.renumber_in_order();
@@ -214,8 +224,11 @@ struct basic_scene {
     std::uint32_t type = 0, object = 0;
   };
   bvh accel_;
-  std::vector<prim_ref> prims_;                 // in the hierarchy's order
-  std::vector<std::array<vec3, 3>> tri_verts_;  // a triangle's vertices, at its place in that order
+  std::vector<prim_ref> prims_;  // in the hierarchy's order
+  // A triangle's vertices and index at its place in that order (tag
+  // not_a_triangle at another shape's); empty in a scene without triangles.
+  std::vector<triangle_vertices, large_array_allocator<triangle_vertices>> tri_verts_;
+  static constexpr std::uint32_t not_a_triangle = ~std::uint32_t(0);
   bool accel_active_ = false;
 
   std::size_t list_object_count() const {
@@ -253,18 +266,39 @@ struct basic_scene {
   bool hit_accelerated(const ray& r, float tmin, closest& c, hit_record& rec) const {
     triangle_hit tri{};  // the barycentrics of the closest triangle so far
     float tmax = c.t;
-    const std::int64_t best = accel_.closest(r, tmin, tmax, [&](std::uint32_t slot, float t0, float t1) -> float {
-      const prim_ref& p = prims_[slot];
-      if constexpr (has_triangles)
-        if (p.type == triangle_type) {
-          const std::array<vec3, 3>& v = tri_verts_[slot];
-          const std::optional<triangle_hit> h = intersect_triangle(r, t1, v[0], v[1], v[2]);
-          if (!h || !(h->t > t0) || !(h->t < t1)) return infinity;
-          tri = *h;
-          return h->t;
+    std::int64_t best = -1;
+    if (!tri_verts_.empty()) {
+      const watertight_ray wr(r);
+      best = accel_.closest_leaf(r, tmin, tmax, [&](std::uint32_t first, std::uint32_t count, float t0, float& t1) {
+        const triangle_vertices* tv = &tri_verts_[first];
+        bool triangles_only = true;
+        for (std::uint32_t i = 0; i < count; ++i) triangles_only &= tv[i].tag != not_a_triangle;
+        if (triangles_only) {
+          const int j = closest_in_leaf(wr, t0, t1, tv, static_cast<int>(count), tri);
+          return j < 0 ? std::int64_t(-1) : std::int64_t(first) + j;
         }
-      return intersect_ref(p, r, t0, t1, std::index_sequence_for<Shapes...>{});
-    });
+        // A leaf with other shapes: one by one.
+        std::int64_t k = -1;
+        for (std::uint32_t i = 0; i < count; ++i) {
+          if (tv[i].tag != not_a_triangle) {
+            const std::optional<triangle_hit> h = intersect_triangle(wr, t1, tv[i].p[0], tv[i].p[1], tv[i].p[2]);
+            if (!h || !(h->t > t0) || !(h->t < t1)) continue;
+            tri = *h;
+            t1 = h->t;
+          } else {
+            const float t = intersect_ref(prims_[first + i], r, t0, t1, std::index_sequence_for<Shapes...>{});
+            if (!(t < t1)) continue;
+            t1 = t;
+          }
+          k = std::int64_t(first) + i;
+        }
+        return k;
+      });
+    } else {
+      best = accel_.closest(r, tmin, tmax, [&](std::uint32_t slot, float t0, float t1) -> float {
+        return intersect_ref(prims_[slot], r, t0, t1, std::index_sequence_for<Shapes...>{});
+      });
+    }
     if (best < 0) {
       // The axis-aligned set's hit, if any.
       if (!c.shape) return false;
@@ -272,15 +306,15 @@ struct basic_scene {
       rec.material = c.material;
       return true;
     }
-    const prim_ref& p = prims_[static_cast<std::size_t>(best)];
+    const auto slot = static_cast<std::size_t>(best);
     if constexpr (has_triangles)
-      if (p.type == triangle_type) {
-        const auto& o = std::get<triangle_type>(objects)[p.object];
+      if (!tri_verts_.empty() && tri_verts_[slot].tag != not_a_triangle) {
+        const auto& o = std::get<triangle_type>(objects)[tri_verts_[slot].tag];
         o.shape.surface_at(r, tri, rec);
         rec.material = o.material;
         return true;
       }
-    fill_ref(p, r, tmax, rec, std::index_sequence_for<Shapes...>{});
+    fill_ref(prims_[slot], r, tmax, rec, std::index_sequence_for<Shapes...>{});
     return true;
   }
 
