@@ -165,8 +165,11 @@ struct triangle {
 
   // The unit geometric normal of the front side (the orientation rule at
   // the top of this header).
-  vec3 normal() const {
-    const vec3 p0 = vertex(0), p1 = vertex(1), p2 = vertex(2);
+  vec3 normal() const { return normal_of(vertex(0), vertex(1), vertex(2)); }
+
+  // The same from the triangle's vertices p0, p1, p2 (as vertex(0..2)),
+  // read by the caller.
+  vec3 normal_of(const vec3& p0, const vec3& p1, const vec3& p2) const {
     vec3 ng = glm::normalize(glm::cross(p1 - p0, p2 - p0));
     if (!mesh->n.empty()) {
       const std::size_t i = 3 * std::size_t(index);
@@ -199,18 +202,25 @@ struct triangle {
   // (1,1) where the mesh has none) and dp/du (pbrt-v4's Triangle::
   // InteractionFromIntersection).
   void surface_at(const ray& r, const triangle_hit& h, hit_record& rec) const {
-    const std::size_t i = 3 * std::size_t(index);
-    const std::uint32_t v0 = mesh->indices[i], v1 = mesh->indices[i + 1], v2 = mesh->indices[i + 2];
-    const vec3 p0 = mesh->p[v0], p1 = mesh->p[v1], p2 = mesh->p[v2];
+    surface_at(r, h, rec, vertex(0), vertex(1), vertex(2));
+  }
+  // The same with the vertices p0, p1, p2 (as vertex(0..2)) the caller has
+  // (the scene's accelerator keeps a copy beside its leaves): the mesh's
+  // indices are read only where it has normals or uv.
+  void surface_at(const ray& r, const triangle_hit& h, hit_record& rec, const vec3& p0, const vec3& p1,
+                  const vec3& p2) const {
     rec.t = h.t;
-    rec.n = normal();
+    rec.n = normal_of(p0, p1, p2);
     rec.p = h.b0 * p0 + h.b1 * p1 + h.b2 * p2;
     // PBRT 4th ed., eq. 6.28: gamma(7) (|b0 p0| + |b1 p1| + |b2 p2|).
     const vec3 error = rounding_gamma(7) * (glm::abs(h.b0 * p0) + glm::abs(h.b1 * p1) + glm::abs(h.b2 * p2));
     rec.offset = glm::dot(glm::abs(rec.n), error);
     rec.front_face = glm::dot(r.d, rec.n) < 0.0f;
     vec2 uv0{0.0f, 0.0f}, uv1{1.0f, 0.0f}, uv2{1.0f, 1.0f};
-    if (!mesh->uv.empty()) uv0 = mesh->uv[v0], uv1 = mesh->uv[v1], uv2 = mesh->uv[v2];
+    if (!mesh->uv.empty()) {
+      const std::size_t i = 3 * std::size_t(index);
+      uv0 = mesh->uv[mesh->indices[i]], uv1 = mesh->uv[mesh->indices[i + 1]], uv2 = mesh->uv[mesh->indices[i + 2]];
+    }
     rec.uv = h.b0 * uv0 + h.b1 * uv1 + h.b2 * uv2;
     const vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
     const vec3 dp02 = p0 - p2, dp12 = p1 - p2;
@@ -219,6 +229,8 @@ struct triangle {
     // any basis about the normal.
     rec.dpdu = std::abs(det) < 1e-9f ? vec3(0.0f) : (duv12.y * dp02 - duv02.y * dp12) / det;
     if (!mesh->n.empty()) {
+      const std::size_t i = 3 * std::size_t(index);
+      const std::uint32_t v0 = mesh->indices[i], v1 = mesh->indices[i + 1], v2 = mesh->indices[i + 2];
       const vec3 ns = h.b0 * mesh->n[v0] + h.b1 * mesh->n[v1] + h.b2 * mesh->n[v2];
       const float len2 = glm::dot(ns, ns);
       rec.ns = len2 > 0.0f ? ns / std::sqrt(len2) : rec.n;

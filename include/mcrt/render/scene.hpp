@@ -309,8 +309,9 @@ struct basic_scene {
     const auto slot = static_cast<std::size_t>(best);
     if constexpr (has_triangles)
       if (!tri_verts_.empty() && tri_verts_[slot].tag != not_a_triangle) {
-        const auto& o = std::get<triangle_type>(objects)[tri_verts_[slot].tag];
-        o.shape.surface_at(r, tri, rec);
+        const triangle_vertices& tv = tri_verts_[slot];
+        const auto& o = std::get<triangle_type>(objects)[tv.tag];
+        o.shape.surface_at(r, tri, rec, tv.p[0], tv.p[1], tv.p[2]);
         rec.material = o.material;
         return true;
       }
