@@ -118,8 +118,10 @@ class axis_rect_set {
                             (pv <= b.b1[l]);
         tl[static_cast<std::size_t>(l)] = inside ? tt : infinity;
       }
-      float best = infinity;
-      for (int l = 0; l < lanes; ++l) best = std::min(best, tl[static_cast<std::size_t>(l)]);
+      // The least of the lanes as a tree of pairs (no lane is NaN, so the
+      // order of the minima does not matter): a chain of log2(lanes) steps
+      // instead of lanes.
+      float best = min_of(tl);
       if (best < tmax) {
         int l = 0;
         while (tl[static_cast<std::size_t>(l)] != best) ++l;
@@ -133,6 +135,17 @@ class axis_rect_set {
   }
 
  private:
+  template <std::size_t N>
+  static float min_of(const std::array<float, N>& v) {
+    if constexpr (N == 1) {
+      return v[0];
+    } else {
+      std::array<float, N / 2> half;
+      for (std::size_t i = 0; i < N / 2; ++i) half[i] = std::min(v[i], v[i + N / 2]);
+      return min_of(half);
+    }
+  }
+
   struct block {
     float k[lanes], a0[lanes], a1[lanes], b0[lanes], b1[lanes];
     float n[3][lanes], u[3][lanes], v[3][lanes];  // one-hot weights of the lane's axes
