@@ -284,7 +284,7 @@ TEST(Bvh, LargeTreeInHugePageStorage) {
 // the same t, point, normal, side, material and uv.
 TEST(SceneAccelerator, HitsAreThoseOfTheLists) {
   mcrt::pcg32 rng(77, 3);
-  int hits = 0;
+  int hits = 0, sides = 0;
   for (int s = 0; s < 40; ++s) {
     mcrt::scene sc;
     for (int m = 0; m < 4; ++m) sc.materials.push_back(mcrt::lambertian{});
@@ -306,7 +306,11 @@ TEST(SceneAccelerator, HitsAreThoseOfTheLists) {
     b.lo = r3() * 0.2f;
     b.hi = b.lo + 0.5f;
     b.xf = mcrt::rigid_y::make(30.0f, r3());
+    b.flip = s % 2 == 1;
     sc.add(b, 1);
+    mcrt::sphere inside_out{r3(), 0.3f};
+    inside_out.flip = true;
+    sc.add(inside_out, 2);
     const mcrt::scene lists = sc;
     sc.build_accelerator();
     ASSERT_TRUE(sc.accelerated());
@@ -325,7 +329,17 @@ TEST(SceneAccelerator, HitsAreThoseOfTheLists) {
       EXPECT_EQ(a.material, c.material);
       EXPECT_EQ(a.uv, c.uv);
       EXPECT_EQ(a.offset, c.offset);
+      // hit_side (shadow rays): the same t, material and side, both ways.
+      for (const mcrt::scene* w : std::initializer_list<const mcrt::scene*>{&lists, &sc}) {
+        mcrt::hit_record side;
+        ASSERT_TRUE(w->hit_side(r, 1e-4f, mcrt::infinity, side));
+        EXPECT_EQ(side.t, a.t);
+        EXPECT_EQ(side.material, a.material);
+        EXPECT_EQ(side.front_face, a.front_face) << "scene " << s << " ray " << i;
+        ++sides;
+      }
     }
   }
   EXPECT_GT(hits, 2000);
+  EXPECT_EQ(sides, 2 * hits);
 }

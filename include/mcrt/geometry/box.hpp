@@ -48,14 +48,9 @@ struct box {
   // grazing angle from there would meet the box again.
   void surface(const ray& world_ray, float t, hit_record& rec) const {
     vec3 p = xf.to_local(world_ray.at(t));
-    const vec3 size = hi - lo;
-    const vec3 dlo = glm::abs(p - lo) / size, dhi = glm::abs(p - hi) / size;
-    int axis = 0;
-    float best = infinity, sign = 0.0f;
-    for (int i = 0; i < 3; ++i) {
-      if (dlo[i] < best) best = dlo[i], axis = i, sign = -1.0f;
-      if (dhi[i] < best) best = dhi[i], axis = i, sign = 1.0f;
-    }
+    int axis;
+    float sign;
+    face_of(p, axis, sign);
     vec3 local_n(0.0f);
     local_n[axis] = sign;
     p[axis] = sign < 0.0f ? lo[axis] : hi[axis];
@@ -72,11 +67,38 @@ struct box {
     rec.front_face = glm::dot(world_ray.d, rec.n) < 0.0f;
   }
 
+  // surface()'s front_face alone (the face and its normal, not the point
+  // or its bound).
+  bool front_face(const ray& world_ray, float t) const {
+    int axis;
+    float sign;
+    face_of(xf.to_local(world_ray.at(t)), axis, sign);
+    vec3 local_n(0.0f);
+    local_n[axis] = sign;
+    const vec3 outward = xf.rotate(local_n);
+    return glm::dot(world_ray.d, flip ? -outward : outward) < 0.0f;
+  }
+
   bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
     float t;
     if (!intersect(r, tmin, tmax, t)) return false;
     surface(r, t, rec);
     return true;
+  }
+
+ private:
+  // The face of the local point p: the one whose plane p is nearest to,
+  // relative to the box's size (axis, and sign -1 for lo, +1 for hi).
+  void face_of(const vec3& p, int& axis, float& sign) const {
+    const vec3 size = hi - lo;
+    const vec3 dlo = glm::abs(p - lo) / size, dhi = glm::abs(p - hi) / size;
+    axis = 0;
+    sign = 0.0f;
+    float best = infinity;
+    for (int i = 0; i < 3; ++i) {
+      if (dlo[i] < best) best = dlo[i], axis = i, sign = -1.0f;
+      if (dhi[i] < best) best = dhi[i], axis = i, sign = 1.0f;
+    }
   }
 };
 

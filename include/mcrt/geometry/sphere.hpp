@@ -54,6 +54,13 @@ struct sphere {
     rec.front_face = glm::dot(r.d, rec.n) < 0.0f;
   }
 
+  // surface()'s front_face from the ray's own point, not moved onto the
+  // sphere (the same side but within rounding of a grazing hit).
+  bool front_face(const ray& r, float t) const {
+    const float d = glm::dot(r.d, r.at(t) - center);
+    return flip ? d > 0.0f : d < 0.0f;
+  }
+
   bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
     float t;
     if (!intersect(r, tmin, tmax, t)) return false;

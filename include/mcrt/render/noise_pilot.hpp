@@ -119,6 +119,10 @@ struct ray_counting_scene {
     ++rays;
     return inner.hit(r, tmin, tmax, rec);
   }
+  bool hit_side(const ray& r, float tmin, float tmax, hit_record& rec) const {
+    ++rays;
+    return inner.hit_side(r, tmin, tmax, rec);
+  }
 };
 
 // The pilot `mcrt render` runs for an image of width x height at spp: 1024

@@ -36,7 +36,7 @@ struct path_settings {
 template <class Scene>
 color shadow_ray_radiance(const Scene& sc, const vec3& p, const vec3& dir) {
   hit_record rec;
-  if (!sc.hit(ray{p, dir}, 0.0f, infinity, rec)) return color(0.0f);
+  if (!sc.hit_side(ray{p, dir}, 0.0f, infinity, rec)) return color(0.0f);
   return emitted(sc.materials[rec.material], rec);
 }
 

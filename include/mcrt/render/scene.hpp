@@ -176,25 +176,39 @@ struct basic_scene {
   // Closest hit in (tmin, tmax). Every shape type offers intersect() (the
   // ray parameter only) and surface() (the full record); only the closest
   // hit pays for its record.
-  bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const {
+  bool hit(const ray& r, float tmin, float tmax, hit_record& rec) const { return find<true>(r, tmin, tmax, rec); }
+
+  // The closest hit's material and side only, what a shadow ray's radiance
+  // needs (render/path.hpp): rec.t, rec.material and rec.front_face are
+  // set, as hit() sets them (up to rounding at grazing hits on spheres),
+  // and the rest of the record (point, rounding bound, normals, uv) is
+  // not computed.
+  bool hit_side(const ray& r, float tmin, float tmax, hit_record& rec) const {
+    return find<false>(r, tmin, tmax, rec);
+  }
+
+ private:
+  // hit() (Full) and hit_side().
+  template <bool Full>
+  bool find(const ray& r, float tmin, float tmax, hit_record& rec) const {
     closest c{tmax};
     if (!axis_rects.empty()) {
       const any_axis_rect* m;
       if (axis_rects.intersect(r, tmin, c.t, c.t, m)) {
         c.shape = m;
         c.fill = &fill_record<any_axis_rect>;
+        c.side = &side_record<any_axis_rect>;
         c.material = m->material;
       }
     }
-    if (accel_active_) return hit_accelerated(r, tmin, c, rec);
+    if (accel_active_) return hit_accelerated<Full>(r, tmin, c, rec);
     std::apply([&](const auto&... v) { (closest_of(v, r, tmin, c), ...); }, objects);
     if (!c.shape) return false;
-    c.fill(c.shape, r, c.t, rec);
+    (Full ? c.fill : c.side)(c.shape, r, c.t, rec);
     rec.material = c.material;
     return true;
   }
 
- private:
   void note_material(std::uint32_t m) {
     if (m >= materials.size() || std::holds_alternative<diffuse_light>(materials[m])) ++unsampled_emitters;
   }
@@ -203,6 +217,7 @@ struct basic_scene {
     float t;
     const void* shape = nullptr;
     void (*fill)(const void*, const ray&, float, hit_record&) = nullptr;
+    void (*side)(const void*, const ray&, float, hit_record&) = nullptr;  // t and front_face only
     std::uint32_t material = 0;
   };
 
@@ -247,19 +262,23 @@ struct basic_scene {
     ((p.type == I ? (void)(t = intersect_ref<I>(p.object, r, tmin, tmax)) : void()), ...);
     return t;
   }
-  template <std::size_t... I>
+  template <bool Full, std::size_t... I>
   void fill_ref(const prim_ref& p, const ray& r, float t, hit_record& rec, std::index_sequence<I...>) const {
-    ((p.type == I ? (void)(fill_one<I>(p.object, r, t, rec)) : void()), ...);
+    ((p.type == I ? (void)(fill_one<Full, I>(p.object, r, t, rec)) : void()), ...);
   }
-  template <std::size_t I>
+  template <bool Full, std::size_t I>
   void fill_one(std::uint32_t object, const ray& r, float t, hit_record& rec) const {
     const auto& o = std::get<I>(objects)[object];
-    o.shape.surface(r, t, rec);
+    if constexpr (Full)
+      o.shape.surface(r, t, rec);
+    else
+      side_of(o.shape, r, t, rec);
     rec.material = o.material;
   }
 
   // Kept out of hit() (GCC's and Clang's noinline): the lists' path of the
   // scenes without a hierarchy stays as small as it was without one.
+  template <bool Full>
 #if defined(__GNUC__) || defined(__clang__)
   [[gnu::noinline]]
 #endif
@@ -302,7 +321,7 @@ struct basic_scene {
     if (best < 0) {
       // The axis-aligned set's hit, if any.
       if (!c.shape) return false;
-      c.fill(c.shape, r, c.t, rec);
+      (Full ? c.fill : c.side)(c.shape, r, c.t, rec);
       rec.material = c.material;
       return true;
     }
@@ -311,11 +330,16 @@ struct basic_scene {
       if (!tri_verts_.empty() && tri_verts_[slot].tag != not_a_triangle) {
         const triangle_vertices& tv = tri_verts_[slot];
         const auto& o = std::get<triangle_type>(objects)[tv.tag];
-        o.shape.surface_at(r, tri, rec, tv.p[0], tv.p[1], tv.p[2]);
+        if constexpr (Full) {
+          o.shape.surface_at(r, tri, rec, tv.p[0], tv.p[1], tv.p[2]);
+        } else {
+          rec.t = tri.t;
+          rec.front_face = glm::dot(r.d, o.shape.normal_of(tv.p[0], tv.p[1], tv.p[2])) < 0.0f;
+        }
         rec.material = o.material;
         return true;
       }
-    fill_ref(prims_[slot], r, tmax, rec, std::index_sequence_for<Shapes...>{});
+    fill_ref<Full>(prims_[slot], r, tmax, rec, std::index_sequence_for<Shapes...>{});
     return true;
   }
 
@@ -339,6 +363,21 @@ struct basic_scene {
   static void fill_record(const void* s, const ray& r, float t, hit_record& rec) {
     static_cast<const Shape*>(s)->surface(r, t, rec);
   }
+  // t and front_face of a hit at t: the shape's front_face(r, t) where it
+  // has one (the side without the rest of the record), else its record.
+  template <class Shape>
+  static void side_of(const Shape& shape, const ray& r, float t, hit_record& rec) {
+    if constexpr (requires { shape.front_face(r, t); }) {
+      rec.t = t;
+      rec.front_face = shape.front_face(r, t);
+    } else {
+      shape.surface(r, t, rec);
+    }
+  }
+  template <class Shape>
+  static void side_record(const void* s, const ray& r, float t, hit_record& rec) {
+    side_of(*static_cast<const Shape*>(s), r, t, rec);
+  }
 
   template <class Shape>
   static void closest_of(const std::vector<object<Shape>>& v, const ray& r, float tmin, closest& c) {
@@ -348,6 +387,7 @@ struct basic_scene {
         c.t = t;
         c.shape = &o.shape;
         c.fill = &fill_record<Shape>;
+        c.side = &side_record<Shape>;
         c.material = o.material;
       }
     }
