@@ -296,6 +296,11 @@ TEST(SceneAccelerator, HitsAreThoseOfTheLists) {
       for (int v = 0; v < 3; ++v) mesh->p.push_back(c + 0.4f * r3()), mesh->uv.push_back({rng.uniform(), rng.uniform()});
       mesh->indices.insert(mesh->indices.end(), {k, k + 1, k + 2});
     }
+    // Orientation by pbrt-v4's rules: reversed meshes, and meshes whose
+    // shading normals pick the front (random ones, either side).
+    mesh->reverse_orientation = s % 3 == 1;
+    if (s % 3 == 2)
+      for (std::size_t v = 0; v < mesh->p.size(); ++v) mesh->n.push_back(glm::normalize(r3() + mcrt::vec3(1e-3f)));
     for (const mcrt::triangle& t : mcrt::triangles_of(mesh)) sc.add(t, 0);
     for (int i = 0; i < 4; ++i) {
       sc.add(mcrt::sphere{r3(), 0.1f + 0.3f * rng.uniform()}, 1);

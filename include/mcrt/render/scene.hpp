@@ -8,6 +8,7 @@
 // set of their own, tested before it.
 #include <array>
 #include <cstdint>
+#include <stdexcept>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -144,7 +145,12 @@ struct basic_scene {
         if (triangles > 0) {
           if (prims_[k].type == triangle_type) {
             const triangle& t = std::get<triangle_type>(objects)[prims_[k].object].shape;
-            tri_verts_[k] = {{t.vertex(0), t.vertex(1), t.vertex(2)}, prims_[k].object};
+            const vec3 p0 = t.vertex(0), p1 = t.vertex(1), p2 = t.vertex(2);
+            if (prims_[k].object >= reversed_bit) throw std::length_error("scene: more than 2^31 - 1 triangles");
+            // Whether the front (the orientation rule's normal) is the side
+            // of (p2 - p0) x (p1 - p0), against (p1 - p0) x (p2 - p0).
+            const bool reversed = glm::dot(t.normal_of(p0, p1, p2), glm::cross(p1 - p0, p2 - p0)) < 0.0f;
+            tri_verts_[k] = {{p0, p1, p2}, prims_[k].object | (reversed ? reversed_bit : 0u)};
           } else {
             tri_verts_[k] = {{vec3(0.0f), vec3(0.0f), vec3(0.0f)}, not_a_triangle};
           }
@@ -241,9 +247,12 @@ struct basic_scene {
   bvh accel_;
   std::vector<prim_ref> prims_;  // in the hierarchy's order
   // A triangle's vertices and index at its place in that order (tag
-  // not_a_triangle at another shape's); empty in a scene without triangles.
+  // not_a_triangle at another shape's), the index's top bit set where the
+  // triangle's front is the side of (p2 - p0) x (p1 - p0) (reversed_bit);
+  // empty in a scene without triangles.
   std::vector<triangle_vertices, large_array_allocator<triangle_vertices>> tri_verts_;
   static constexpr std::uint32_t not_a_triangle = ~std::uint32_t(0);
+  static constexpr std::uint32_t reversed_bit = std::uint32_t(1) << 31;
   bool accel_active_ = false;
 
   std::size_t list_object_count() const {
@@ -329,12 +338,16 @@ struct basic_scene {
     if constexpr (has_triangles)
       if (!tri_verts_.empty() && tri_verts_[slot].tag != not_a_triangle) {
         const triangle_vertices& tv = tri_verts_[slot];
-        const auto& o = std::get<triangle_type>(objects)[tv.tag];
+        const auto& o = std::get<triangle_type>(objects)[tv.tag & ~reversed_bit];
         if constexpr (Full) {
           o.shape.surface_at(r, tri, rec, tv.p[0], tv.p[1], tv.p[2]);
         } else {
+          // The side from the vertices and the orientation bit, without
+          // the mesh's normals (the same side as surface_at's normal, up to
+          // rounding at grazing hits).
+          const float along = glm::dot(r.d, glm::cross(tv.p[1] - tv.p[0], tv.p[2] - tv.p[0]));
           rec.t = tri.t;
-          rec.front_face = glm::dot(r.d, o.shape.normal_of(tv.p[0], tv.p[1], tv.p[2])) < 0.0f;
+          rec.front_face = (tv.tag & reversed_bit) ? along > 0.0f : along < 0.0f;
         }
         rec.material = o.material;
         return true;
