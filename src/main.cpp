@@ -227,7 +227,8 @@ int run_render(const render_options& opt) {
                           {"rest_noise", a.rest_noise},
                           {"fixed_point_steps", a.fixed_point_steps},
                           {"cheapest", a.cheapest},
-                          {"gain_factor_seconds", a.kappa_seconds}});
+                          {"gain_factor_seconds", a.kappa_seconds},
+                          {"rest_pilot_seconds", a.rest_pilot_seconds}});
       j["auto_lights"] = lights;
     }
     write_text(opt.stats, j.dump(2) + "\n");

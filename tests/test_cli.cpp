@@ -366,6 +366,10 @@ TEST_F(Cli, AutoNoisePilotInStats) {
   EXPECT_NEAR(parts, j["auto_pilot_seconds"].get<double>(), 1e-12 * parts);
   ASSERT_EQ(j["auto_lights"].size(), 1u);
   EXPECT_GE(j["auto_lights"][0]["fixed_point_steps"].get<int>(), 0);
+  // mis: R from the low-variance pilot, run within the settling.
+  EXPECT_GT(j["auto_lights"][0]["rest_pilot_seconds"].get<double>(), 0.0);
+  EXPECT_LT(j["auto_lights"][0]["rest_pilot_seconds"].get<double>(),
+            j["auto_pilot_parts_seconds"]["settle"].get<double>());
   // The emission term with the image's samples (no emitter in view here:
   // no edge pixels, kappa_E = 1), and with independent samples kappa_E = 1.
   for (const char* sampler : {"sobol", "independent"}) {

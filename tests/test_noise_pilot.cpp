@@ -139,6 +139,32 @@ TEST(NoisePilot, EmittersInViewUnbiasedAndSteadier) {
   EXPECT_LT(std::sqrt(v8), 0.5 * std::sqrt(v0)) << "the emission rays must steady the pilot";
 }
 
+// V's reflected part alone (reflected_only, the low-variance pilot's:
+// render/choice_gain_pilot.hpp): the same paths as the full pilot's (its
+// emission rays draw from their own seeds), so with an emitter in view it
+// is the full pilot's V less its emission term V_E, to rounding, with
+// V_E > 0 here (the premise), and its own emission term is 0.
+TEST(NoisePilot, ReflectedOnlyIsVLessTheEmissionTerm) {
+  scene sc;
+  sc.materials = {lambertian{color(0.3f)}, diffuse_light{color(20.0f)}};
+  sc.add(xz_rect_shape{-50, 50, -50, 50, 0}, 0);
+  sc.add_light(rect_area_sampler{xy_rect(-0.3f, 0.3f, 0.3f, 0.7f, 0.5f, true)}, 1);
+  const camera cam({0, 0.6f, -2}, {0, 0.4f, 0}, {0, 1, 0}, 40, 1.0f);
+  render_settings rs = settings(32, 32);
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    rs.seed = seed;
+    noise_pilot_settings ps{1024, 2, 8};
+    const noise_pilot_result full = estimate_image_variance(sc, cam, rs, ps);
+    ps.reflected_only = true;
+    const noise_pilot_result refl = estimate_image_variance(sc, cam, rs, ps);
+    ASSERT_GT(full.edge_variance, 0.01 * full.image_variance) << "the premise: an emission term";
+    EXPECT_EQ(refl.edge_variance, 0.0);
+    EXPECT_NEAR(refl.image_variance, full.image_variance - full.edge_variance, 1e-9 * full.image_variance) << seed;
+    ASSERT_EQ(refl.light_variance.size(), 1u);
+    EXPECT_EQ(refl.light_variance[0], full.light_variance[0]);
+  }
+}
+
 // A light in view whose edges cross few pixels: a pilot of every k-th
 // pixel meets a share of the edge pixels that depends on where its grid
 // falls, which no seed averages out: measured on a grid of half the

@@ -29,12 +29,29 @@
 // errs towards the choice), at most V's reflected part, 1 - V_E / V (V_E,
 // V's emission term, holds none of a light sample's noise).
 //
-// R = V max(1 - s, b), b the BSDF samples' part of the light's estimate
-// with mis (auto_sampler::mis_floor, auto_choice::v_bsdf_mis; 0 with nee):
-// with s clamped to 1, R = V (1 - s) would be 0, V_l would fall to 0 and
-// projected solid angle (modelled variance 0) would be taken everywhere at
-// any cost (2.2x slower than solid angle for the same error over a floor at
-// 0.3 light sizes, distance_h0.3).
+// R, the image's noise beyond the light's, from a second pilot with every
+// light `auto` samples by its lowest-variance strategy, projected solid
+// angle (low_variance_pilot, run once for all of them): its reflected
+// part (the light's noise left there, from occlusion, the choice cannot
+// remove either), plus the first pilot's emission term V_E; at least V b, b the
+// BSDF samples' part of the light's estimate with mis (auto_sampler::
+// mis_floor, auto_choice::v_bsdf_mis). Not V (1 - s): with the cheapest
+// strategy under a sliver the pilot's V is heavy-tailed (tri_aspect_a10000,
+// 8 spp: V 0.0057, 0.0047 and 0.00066 at seeds 1-3, while s V stays near
+// 0.0028), R = V (1 - s) took the tail in, and at some seeds the choice
+// was weighed against several times the image's noise and kept cheaper
+// strategies where projected solid angle has a hundredth of their variance
+// (4 of the 12 renders of tri_aspect_a1000 and a10000 had 19-170x its
+// error; with the second pilot none, and auto went from 0.66-0.74x to
+// 1.04-1.08x the best fixed strategy there). With the light's own noise
+// small, the rest is steady (under a sliver of aspect 10^4, over 6 pilot
+// seeds, R varies 3.1x where V varies 68x). The second pilot is part of
+// auto's time.
+// Without the floor V b, where the rest is all the light's (a bare floor
+// under it) R would be 0, V_l would fall to 0 and projected solid angle
+// (modelled variance 0) would be taken everywhere at any cost (2.2x slower
+// than solid angle for the same error over a floor at 0.3 light sizes,
+// distance_h0.3).
 //
 // The image's own samples (stratified, Sobol) leave less of a light's noise
 // than independent ones (the factor kappa, 0.01-0.2 with direct light),
@@ -146,6 +163,33 @@ int settle_fixed_point(const Auto& s, std::span<const auto_receiver> rs, std::sp
   return k;
 }
 
+// The noise pilot `mcrt render` runs (noise_pilot_for), V's reflected part
+// alone (no emission rays, no light's own noise measured), with every
+// light `auto` samples by its
+// projected-solid-angle sampler (the strategy of least variance, 0 in the
+// rule's model: the rule's choice at V -> 0, without its lookups and table
+// to fill): the lights are restored on return. No reference into sc.lights
+// may be held across the call.
+template <class Scene>
+noise_pilot_result low_variance_pilot(Scene& sc, const camera& cam, const render_settings& rs) {
+  auto kept = sc.lights;
+  for (light& l : sc.lights) {
+    std::optional<light> projected;
+    std::visit(
+        [&]<class S>(const S& s) {
+          if constexpr (strategy_of<S>() == light_sampling::automatic) projected = s.projected;
+        },
+        l);
+    if (projected) l = std::move(*projected);
+  }
+  noise_pilot_settings ps = noise_pilot_for(rs.width, rs.height, rs.spp);
+  ps.reflected_only = true;
+  ps.light_noise_limit = 0;  // the lights' own noise is not taken out (header)
+  noise_pilot_result r = estimate_image_variance(sc, cam, rs, ps);
+  sc.lights = std::move(kept);
+  return r;
+}
+
 // What settle_auto_lights found for one light sampled by `auto`.
 struct auto_light_settlement {
   std::size_t light = 0;        // index in the scene's lights
@@ -155,6 +199,7 @@ struct auto_light_settlement {
   double noise_share = 0.0;     // s: the light's own noise with its cheapest strategy, over V
   double noise_share_measured = 0.0, noise_share_model = 0.0;
   double rest_noise = 0.0;      // R: the image's noise beyond the light's (header)
+  double rest_pilot_seconds = 0.0;  // the low-variance pilot's time, on the light that ran it (mis, mixture: header)
   double image_variance = 0.0;  // V_l: the V its rule sees
   double rest_cost = 0.0;       // c_rest its rule took, ns per light sample (with its choice's own cost: header)
   int fixed_point_steps = 0;    // the steps its V_l and c_rest took to their fixed point
@@ -173,7 +218,10 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
                                                       const noise_pilot_result& noise, int pixels,
                                                       bool model_rest_cost = true) {
   std::vector<auto_light_settlement> out;
+  std::optional<noise_pilot_result> low;  // run where a light with mis first needs R
+  double low_seconds = 0.0;               // its time, reported on that light
   for (std::size_t i = 0; i < sc.lights.size(); ++i) {
+    bool need_low = false;
     std::optional<light> rebuilt;
     // The rule's models at the pilot's receivers: the light's and the
     // points' alone, so one evaluation serves every params weighed below.
@@ -233,7 +281,15 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
               rebuilt = s.with_params(p);
               return;
             }
-            a.rest_noise = v * std::max(1.0 - a.noise_share, s.mis_floor(models));
+            // mis and mixture: R from the low-variance pilot (header), at
+            // least V b; run once, outside this visit (it swaps the lights).
+            if (!low) {
+              need_low = true;
+              return;
+            }
+            a.rest_pilot_seconds = low_seconds;
+            low_seconds = 0.0;
+            a.rest_noise = std::max(low->image_variance + noise.edge_variance, v * s.mis_floor(models));
             a.fixed_point_steps = settle_fixed_point(s, noise.receivers, models, v, a.noise_share, a.rest_noise,
                                                      a.rest_cost, p);
             a.image_variance = p.image_variance;
@@ -242,6 +298,14 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
           }
         },
         sc.lights[i]);
+    if (need_low) {
+      // The low-variance pilot, then this light again.
+      const auto start = std::chrono::steady_clock::now();
+      low = low_variance_pilot(sc, cam, rs);
+      low_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      --i;  // unsigned: wraps at 0, and the loop's ++i brings it back
+      continue;
+    }
     if (screened) {
       a.cheapest = use_cheapest(sc.lights[i]);
       out.push_back(a);

@@ -100,6 +100,9 @@ struct noise_pilot_settings {
   // takes the light's share of the noise from its model alone
   // (render/choice_gain_pilot.hpp).
   std::size_t light_noise_limit = 256;
+  // V's reflected part alone: what the camera rays meet first taken out of
+  // each sample, and no emission term (no emission rays; edge_variance 0).
+  bool reflected_only = false;
 };
 
 // A scene that counts the rays traced in it (its hit tests) and otherwise is
@@ -299,7 +302,8 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
   const int k = out.stride;
   const int nx = (rs.width + k - 1) / k, ny = (rs.height + k - 1) / k;
   // The finer blocks of the emission term (header) and its rays per pixel.
-  const int k_rays = ps.emission_rays >= 2 ? ps.emission_rays : 0;
+  const int k_rays = ps.emission_rays >= 2 && !ps.reflected_only ? ps.emission_rays : 0;
+  const bool split = k_rays > 0 || ps.reflected_only;  // E taken out of each sample
   const int ke = (k + 1) / 2;
   const int nxe = k_rays ? (rs.width + ke - 1) / ke : 0, nye = k_rays ? (rs.height + ke - 1) / ke : 0;
   const int ke_rays =
@@ -483,7 +487,7 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
           const color v = path_values[static_cast<std::size_t>(i * m + s)];
           if (!all_finite(v)) continue;
           c[static_cast<std::size_t>(finite)] = glm::dvec3(v);
-          if (k_rays) e[static_cast<std::size_t>(finite)] = glm::dvec3(radiance_met_first(sc, r));
+          if (split) e[static_cast<std::size_t>(finite)] = glm::dvec3(radiance_met_first(sc, r));
           ++finite;
           // Each light's own noise at the surface the camera ray meets:
           // two independent samples of it there, (f1 - f2)^2 / 2 (its
@@ -512,7 +516,7 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
         if (finite < 2) continue;
         // What the camera rays meet first taken out of each sample (its
         // variance comes from the finer blocks: header).
-        if (k_rays)
+        if (split)
           for (int i = 0; i < finite; ++i) c[static_cast<std::size_t>(i)] -= e[static_cast<std::size_t>(i)];
         sum += b.weight * sample_variance(c.data(), finite);
         weights += b.weight;
