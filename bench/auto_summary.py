@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
-"""auto against the fixed strategies on the study's triangle families (a results.csv of scripts/study.py).
+"""auto against the fixed strategies in a results.csv of scripts/study.py (the triangle families, the strategy map).
 
-Per scene and strategy, the efficiency 1/(MSE x seconds) of each seed, averaged over the sweep's spp;
-per scene the ratio auto / best fixed strategy (the best by its mean over seeds) and auto / pbrt, each
+Per scene and depth mode (global light marked), and per strategy, the efficiency 1/(MSE x seconds) of each seed, averaged over the sweep's spp;
+per scene the ratio auto / best fixed strategy (the best by its mean over seeds) and auto / pbrt (where
+pbrt was run), each
 as the mean over seeds with a 95 % t interval (3 seeds: t = 4.30); then the geometric means over the
 scenes. Prints a markdown table.
 
-    python3 bench/triangle_auto_summary.py bench/results/triangle_map/results.csv
+    python3 bench/auto_summary.py bench/results/triangle_map/results.csv
 """
 import csv
 import math
@@ -24,11 +25,14 @@ def main(path: str) -> int:
         mse, sec = float(r["mse"]), float(r["seconds"])
         if not (mse > 0 and sec > 0):
             continue
-        eff[r["scene"]][(r["strategy"], int(r["seed"]))].append(1.0 / (mse * sec))
-        params[r["scene"]] = (r["family"], float(r["family_param"]), float(r["light_solid_angle"]))
+        scene = r["scene"] + ("" if r["max_depth"] == "1" else " (global)")
+        eff[scene][(r["strategy"], int(r["seed"]))].append(1.0 / (mse * sec))
+        params[scene] = (r["family"], float(r["family_param"]), r["max_depth"], float(r["light_solid_angle"]))
     fixed = ["area", "solid-angle", "projected-solid-angle", "bilinear-solid-angle", "pbrt"]
-    print("| scene | solid angle (sr) | best fixed | auto ÷ best (95 % CI over seeds) | auto ÷ pbrt (95 % CI) | auto's rank |")
-    print("|---|---:|---|---:|---:|---:|")
+    with_pbrt = any(s == "pbrt" for per in eff.values() for s, _ in per)
+    print("| scene | solid angle (sr) | best fixed | auto ÷ best (95 % CI over seeds) |"
+          + (" auto ÷ pbrt (95 % CI) |" if with_pbrt else "") + " auto's rank |")
+    print("|---|---:|---|---:|" + ("---:|" if with_pbrt else "") + "---:|")
     g_best, g_pbrt, below = [], [], []
     for scene in sorted(eff, key=lambda s: params[s][:2]):
         per = eff[scene]
@@ -46,17 +50,20 @@ def main(path: str) -> int:
             return m, h, mean["auto"] / mean[other]
 
         mb, hb, rb = ratio(best)
-        mp, hp, rp = ratio("pbrt")
         rank = 1 + sum(mean[s] > mean["auto"] for s in fixed if s in mean)
         g_best.append(rb)
-        g_pbrt.append(rp)
         if rb < 0.9:
             below.append(scene)
-        print(f"| {scene} | {params[scene][2]:.3g} | {best} | {rb:.3f} ({mb - hb:.2f}–{mb + hb:.2f}) | "
-              f"{rp:.3f} ({mp - hp:.2f}–{mp + hp:.2f}) | {rank} |")
+        pbrt_cell = ""
+        if with_pbrt:
+            mp, hp, rp = ratio("pbrt")
+            g_pbrt.append(rp)
+            pbrt_cell = f" {rp:.3f} ({mp - hp:.2f}–{mp + hp:.2f}) |"
+        print(f"| {scene} | {params[scene][3]:.3g} | {best} | {rb:.3f} ({mb - hb:.2f}–{mb + hb:.2f}) |{pbrt_cell} {rank} |")
     gm = lambda xs: math.exp(sum(map(math.log, xs)) / len(xs))
-    print(f"\nGeometric means over {len(g_best)} scenes: auto ÷ best fixed {gm(g_best):.3f}, auto ÷ pbrt {gm(g_pbrt):.3f}; "
-          f"auto below 0.9× the best at {len(below)}: {', '.join(below) or 'none'}.")
+    print(f"\nGeometric means over {len(g_best)} scenes: auto ÷ best fixed {gm(g_best):.3f}"
+          + (f", auto ÷ pbrt {gm(g_pbrt):.3f}" if with_pbrt else "")
+          + f"; auto below 0.9× the best at {len(below)}: {', '.join(below) or 'none'}.")
     return 0
 
 
