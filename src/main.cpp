@@ -54,8 +54,10 @@ std::string strategy_summary(const loaded_scene& ls) {
   const scene& world = ls.world;
   std::optional<light_sampling> first;
   for (const emitter& e : world.emitters) {
-    // A light `auto` found best sampled by its cheapest strategy is still auto's.
-    const bool cheapest = std::ranges::find(ls.auto_cheapest_lights, e.light) != ls.auto_cheapest_lights.end();
+    // A light `auto` found best sampled by its cheapest strategy is still
+    // auto's (the list is in increasing order: a binary search, as a scene
+    // may hold 10^5 of them).
+    const bool cheapest = std::ranges::binary_search(ls.auto_cheapest_lights, e.light);
     const light_sampling s = cheapest ? light_sampling::automatic : strategy_of(world.lights[e.light]);
     if (first && *first != s) return "mixed";
     first = s;

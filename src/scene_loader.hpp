@@ -57,7 +57,7 @@ struct loaded_scene {
   double auto_setup_seconds = 0.0;
   // Of those, the lights (indices in world.lights) whose per-point choice
   // did not pay for its cost at the noise pilot's receivers: sampled by
-  // their cheapest strategy everywhere.
+  // their cheapest strategy everywhere. In increasing order.
   std::vector<std::uint32_t> auto_cheapest_lights;
 };
 
