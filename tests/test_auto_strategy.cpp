@@ -999,3 +999,37 @@ TEST(AutoTable, AgreesWithTheRuleAtMostReceivers) {
 }
 
 }  // namespace
+
+// The triangles' screen (auto_sampler::cheapest_at_every, the settling's
+// fast path) against the rule itself: wherever it passes a set of
+// receivers, the rule's choice is area sampling at every one of them. 3
+// image variances x 3000 sets of 4 receivers drawn around a triangle
+// (fixed seed) on either side, normals towards its plane; it must pass some sets
+// and, at some receivers, through the coarse model where the delta method
+// alone does not decide (the premise of its second test).
+TEST(AutoStrategy, TriangleScreenIsTheRulesChoice) {
+  const triangle t = make_triangle({-1.0f, 0.0f, -0.8f}, {1.2f, 0.0f, -0.6f}, {-0.2f, 0.0f, 1.0f});
+  const planar_rule rule(t);
+  pcg32 g(20261204, 1);
+  int passed = 0, by_coarse = 0;
+  for (const float v : {1e-4f, 1e-2f, 1.0f}) {
+    const triangle_auto_sampler s(t, noise_params(v));
+    for (int k = 0; k < 3000; ++k) {
+      std::array<auto_receiver, 4> rs;
+      for (auto_receiver& r : rs) {
+        const float side = g.uniform() < 0.5f ? 1.0f : -1.0f;  // either side of the light
+        r.p = vec3(8.0f * g.uniform() - 4.0f, side * (0.01f + 4.0f * g.uniform()), 8.0f * g.uniform() - 4.0f);
+        r.n = glm::normalize(vec3(g.uniform() - 0.5f, -side * g.uniform(), g.uniform() - 0.5f));
+      }
+      if (!s.cheapest_at_every(rs)) continue;
+      ++passed;
+      for (const auto_receiver& r : rs) {
+        ASSERT_EQ(rule.choose(r.p, r.n, s.params), light_sampling::area) << "V " << v << ", set " << k;
+        by_coarse += !rule.first_test_takes_area(r.p, r.n, s.params);
+      }
+    }
+  }
+  std::printf("screen passed %d of 9000 sets; %d receivers by the coarse model\n", passed, by_coarse);
+  EXPECT_GT(passed, 100);
+  EXPECT_GT(by_coarse, 10);
+}
