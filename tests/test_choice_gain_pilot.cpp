@@ -333,6 +333,48 @@ TEST(ChoiceGainPilot, SettleWeighsEachAutoLight) {
   }
 }
 
+// The sliver tests' scene: a triangle light along x at height 1 (corners
+// (-l, 1, z0), (l, 1, z0), (0, 1, z1)), sampled by area
+// until a test makes it `auto`, over a floor of half-side `floor`, seen from
+// above at 64 x 64, 8 spp, Sobol, direct light.
+struct sliver_floor {
+  triangle t;
+  float radiance, albedo;
+  scene pilot_scene;
+  camera cam{{0, 6.0f, -3.0f}, {0, 0, 0}, {0, 1, 0}, 70, 1.0f};
+  sliver_floor(float l, float z0, float z1, float albedo_, float radiance_, float floor)
+      : radiance(radiance_), albedo(albedo_) {
+    auto mesh = std::make_shared<triangle_mesh>();
+    mesh->p = {vec3(-l, 1.0f, z0), vec3(l, 1.0f, z0), vec3(0.0f, 1.0f, z1)};
+    mesh->indices = {0, 1, 2};
+    t = triangle{mesh, 0};
+    pilot_scene.materials = {lambertian{color(albedo)}, diffuse_light{color(radiance)}};
+    pilot_scene.add(xz_rect_shape{-floor, floor, -floor, floor, 0}, 0);
+    pilot_scene.add_light(triangle_area_sampler{t}, 1);
+  }
+  static render_settings settings_with_seed(std::uint64_t seed) {
+    render_settings rs = settings(64, 64);
+    rs.spp = 8;
+    rs.sampler = sampler_kind::sobol;
+    rs.seed = seed;
+    return rs;
+  }
+  // The light's `auto` params with the pilot's V.
+  auto_params params(const noise_pilot_result& noise) const {
+    auto_params p;
+    p.image_variance = static_cast<float>(noise.image_variance);
+    p.radiance = radiance;
+    p.albedo = albedo;
+    return p;
+  }
+  // The scene with its light sampled by `auto` with params p.
+  scene with_auto(const auto_params& p) const {
+    scene sc = pilot_scene;
+    sc.lights[0] = triangle_auto_sampler(t, p);
+    return sc;
+  }
+};
+
 // The fixed point takes the choice as a whole: over a floor under a sliver
 // of aspect 100 (length 10 at height 1, tri_aspect_a100's light; direct
 // light, Sobol, 64 x 64 at 8 spp), area sampling's noise is all of the
@@ -343,27 +385,14 @@ TEST(ChoiceGainPilot, SettleWeighsEachAutoLight) {
 // V_l is a small part of V and the dearer strategies are taken at all of
 // them.
 TEST(ChoiceGainPilot, FixedPointTakesTheChoiceAsAWhole) {
-  auto mesh = std::make_shared<triangle_mesh>();
-  mesh->p = {vec3(-5.0f, 1.0f, -0.0288675f), vec3(5.0f, 1.0f, -0.0288675f), vec3(0.0f, 1.0f, 0.057735f)};
-  mesh->indices = {0, 1, 2};
-  const triangle t{mesh, 0};
-  scene pilot_scene;
-  pilot_scene.materials = {lambertian{color(0.5f)}, diffuse_light{color(4.0f)}};
-  pilot_scene.add(xz_rect_shape{-50, 50, -50, 50, 0}, 0);
-  pilot_scene.add_light(triangle_area_sampler{t}, 1);
-  const camera cam({0, 6.0f, -3.0f}, {0, 0, 0}, {0, 1, 0}, 70, 1.0f);
-  render_settings rs = settings(64, 64);
-  rs.spp = 8;
-  rs.sampler = sampler_kind::sobol;
-  rs.seed = 9;
-  const noise_pilot_result noise = estimate_image_variance(pilot_scene, cam, rs);
+  const sliver_floor f(5.0f, -0.0288675f, 0.057735f, 0.5f, 4.0f, 50.0f);
+  const triangle& t = f.t;
+  const camera& cam = f.cam;
+  const render_settings rs = sliver_floor::settings_with_seed(9);
+  const noise_pilot_result noise = estimate_image_variance(f.pilot_scene, cam, rs);
   ASSERT_GT(noise.image_variance, 0.0);
-  auto_params p;
-  p.image_variance = static_cast<float>(noise.image_variance);
-  p.radiance = 4.0f;
-  p.albedo = 0.5f;
-  scene sc = pilot_scene;
-  sc.lights[0] = triangle_auto_sampler(t, p);
+  const auto_params p = f.params(noise);
+  scene sc = f.with_auto(p);
   const std::vector<auto_light_settlement> a = settle_auto_lights(sc, cam, rs, noise, 64);
   ASSERT_EQ(a.size(), 1u);
   ASSERT_FALSE(a[0].cheapest);
@@ -394,29 +423,14 @@ TEST(ChoiceGainPilot, FixedPointTakesTheChoiceAsAWhole) {
 // 3.1x (at most 5x asserted) and is at most 0.1 V at every seed, and every
 // receiver under the light gets a strategy dearer than area sampling.
 TEST(ChoiceGainPilot, RestUnderASliverIsTheLowVariancePilots) {
-  auto mesh = std::make_shared<triangle_mesh>();
-  mesh->p = {vec3(-50.0f, 1.0f, -0.002887f), vec3(50.0f, 1.0f, -0.002887f), vec3(0.0f, 1.0f, 0.005774f)};
-  mesh->indices = {0, 1, 2};
-  const triangle t{mesh, 0};
-  scene pilot_scene;
-  pilot_scene.materials = {lambertian{color(0.73f)}, diffuse_light{color(10.0f)}};
-  pilot_scene.add(xz_rect_shape{-200, 200, -200, 200, 0}, 0);
-  pilot_scene.add_light(triangle_area_sampler{t}, 1);
-  const camera cam({0, 6.0f, -3.0f}, {0, 0, 0}, {0, 1, 0}, 70, 1.0f);
+  const sliver_floor f(50.0f, -0.002887f, 0.005774f, 0.73f, 10.0f, 200.0f);
+  const camera& cam = f.cam;
   double largest_old_rest = 0.0, v_min = 1e30, v_max = 0.0, r_min = 1e30, r_max = 0.0;
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
-    render_settings rs = settings(64, 64);
-    rs.spp = 8;
-    rs.sampler = sampler_kind::sobol;
-    rs.seed = seed;
-    const noise_pilot_result noise = estimate_image_variance(pilot_scene, cam, rs, noise_pilot_for(64, 64, 8));
+    const render_settings rs = sliver_floor::settings_with_seed(seed);
+    const noise_pilot_result noise = estimate_image_variance(f.pilot_scene, cam, rs, noise_pilot_for(64, 64, 8));
     ASSERT_GT(noise.image_variance, 0.0);
-    auto_params p;
-    p.image_variance = static_cast<float>(noise.image_variance);
-    p.radiance = 10.0f;
-    p.albedo = 0.73f;
-    scene sc = pilot_scene;
-    sc.lights[0] = triangle_auto_sampler(t, p);
+    scene sc = f.with_auto(f.params(noise));
     const std::vector<auto_light_settlement> a = settle_auto_lights(sc, cam, rs, noise, 64);
     ASSERT_EQ(a.size(), 1u);
     ASSERT_FALSE(a[0].cheapest);
