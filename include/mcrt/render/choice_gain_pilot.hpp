@@ -43,7 +43,7 @@
 // strategies where projected solid angle has a hundredth of their variance
 // (4 of the 12 renders of tri_aspect_a1000 and a10000 had 19-170x its
 // error; with the second pilot none, and auto went from 0.66-0.74x to
-// 1.04-1.08x the best fixed strategy there). With the light's own noise
+// 0.97-1.05x the best fixed strategy there). With the light's own noise
 // small, the rest is steady (under a sliver of aspect 10^4, over 6 pilot
 // seeds, R varies 3.1x where V varies 68x). The second pilot is part of
 // auto's time.
