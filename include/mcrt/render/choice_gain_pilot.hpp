@@ -172,21 +172,28 @@ int settle_fixed_point(const Auto& s, std::span<const auto_receiver> rs, std::sp
 // may be held across the call.
 template <class Scene>
 noise_pilot_result low_variance_pilot(Scene& sc, const camera& cam, const render_settings& rs) {
-  auto kept = sc.lights;
-  for (light& l : sc.lights) {
+  // The auto lights moved out (no copies: many lights are many shared
+  // tables' reference counts), their projected samplers in their place.
+  std::vector<std::pair<std::size_t, light>> kept;
+  kept.reserve(static_cast<std::size_t>(std::count_if(sc.lights.begin(), sc.lights.end(), [](const light& l) {
+    return std::visit([]<class S>(const S&) { return strategy_of<S>() == light_sampling::automatic; }, l);
+  })));
+  for (std::size_t i = 0; i < sc.lights.size(); ++i) {
     std::optional<light> projected;
     std::visit(
         [&]<class S>(const S& s) {
           if constexpr (strategy_of<S>() == light_sampling::automatic) projected = s.projected;
         },
-        l);
-    if (projected) l = std::move(*projected);
+        sc.lights[i]);
+    if (!projected) continue;
+    kept.emplace_back(i, std::move(sc.lights[i]));
+    sc.lights[i] = std::move(*projected);
   }
   noise_pilot_settings ps = noise_pilot_for(rs.width, rs.height, rs.spp);
   ps.reflected_only = true;
   ps.light_noise_limit = 0;  // the lights' own noise is not taken out (header)
   noise_pilot_result r = estimate_image_variance(sc, cam, rs, ps);
-  sc.lights = std::move(kept);
+  for (auto& [i, l] : kept) sc.lights[i] = std::move(l);
   return r;
 }
 
@@ -211,16 +218,47 @@ struct auto_light_settlement {
 // V_l and c_rest at their fixed point (header); then, where that rule's
 // choice does not pay at the pilot's receivers
 // (use_cheapest_where_choice_does_not_pay), its cheapest strategy.
-// Triangles whose rule's first test takes area sampling at every receiver
-// get it without the models (auto_sampler::cheapest_at_every).
+// First, triangles whose rule takes area sampling at every receiver before
+// its fine model (auto_sampler::cheapest_at_every) get it without the
+// models; then the others are settled, with mis and mixture R measured
+// with the first ones as they will be rendered.
 template <class Scene>
 std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& cam, const render_settings& rs,
                                                       const noise_pilot_result& noise, int pixels,
                                                       bool model_rest_cost = true) {
-  std::vector<auto_light_settlement> out;
   std::optional<noise_pilot_result> low;  // run where a light with mis first needs R
   double low_seconds = 0.0;               // its time, reported on that light
+  // c_rest from the pilot's counted rays and paths per light sample
+  // (render/rest_cost.hpp), for a light of shape S.
+  const float tests_per_ray = intersection_cost_per_ray(sc);
+  const auto with_rest_cost = [&]<class S>(const S& s) {
+    auto_params p = s.params;
+    if (model_rest_cost && noise.rays_per_light_sample > 0.0)
+      p.rest_cost = modelled_rest_cost(noise.rays_per_light_sample, noise.paths_per_light_sample, tests_per_ray,
+                                       light_shape_cost<decltype(s.shape)>());
+    return p;
+  };
+  std::vector<std::optional<auto_light_settlement>> found(sc.lights.size());
+  // The screen.
+  const auto_receiver_groups receiver_groups(noise.receivers);
   for (std::size_t i = 0; i < sc.lights.size(); ++i) {
+    const bool screened = std::visit(
+        [&]<class S>(const S& s) {
+          if constexpr (strategy_of<S>() == light_sampling::automatic) {
+            const auto_params p = with_rest_cost(s);
+            if (!s.cheapest_at_every(receiver_groups, p)) return false;
+            auto_light_settlement a;
+            a.light = i, a.rest_cost = p.rest_cost, a.image_variance = p.image_variance;
+            found[i] = a;
+            return true;
+          }
+          return false;
+        },
+        sc.lights[i]);
+    if (screened) found[i]->cheapest = use_cheapest(sc.lights[i]);
+  }
+  for (std::size_t i = 0; i < sc.lights.size(); ++i) {
+    if (found[i]) continue;
     bool need_low = false;
     std::optional<light> rebuilt;
     // The rule's models at the pilot's receivers: the light's and the
@@ -228,23 +266,13 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
     std::vector<auto_choice> models;
     auto_light_settlement a;
     a.light = i;
-    bool screened = false;  // the rule's first test takes the cheapest strategy at every receiver
     std::visit(
         [&]<class S>(const S& s) {
           if constexpr (strategy_of<S>() == light_sampling::automatic) {
-            auto_params p = s.params;
-            // c_rest from the pilot's counted rays and paths per light
-            // sample (render/rest_cost.hpp).
-            if (model_rest_cost && noise.rays_per_light_sample > 0.0)
-              p.rest_cost = modelled_rest_cost(noise.rays_per_light_sample, noise.paths_per_light_sample,
-                                               intersection_cost_per_ray(sc), light_shape_cost<decltype(s.shape)>());
+            auto_params p = with_rest_cost(s);
             a.rest_cost = p.rest_cost;
-            const S with_cost = s.with_params(p);
             a.image_variance = p.image_variance;
-            if (with_cost.cheapest_at_every(noise.receivers)) {
-              screened = true;
-              return;
-            }
+            const S with_cost = s.with_params(p);
             models = with_cost.receiver_models(noise.receivers);
             const double v = s.params.image_variance;
             const double measured = i < noise.light_variance.size() && v > 0.0 ? noise.light_variance[i] / v : 0.0;
@@ -306,16 +334,14 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
       --i;  // unsigned: wraps at 0, and the loop's ++i brings it back
       continue;
     }
-    if (screened) {
-      a.cheapest = use_cheapest(sc.lights[i]);
-      out.push_back(a);
-      continue;
-    }
     if (!rebuilt) continue;
     sc.lights[i] = std::move(*rebuilt);
     a.cheapest = use_cheapest_where_choice_does_not_pay(sc.lights[i], noise.receivers, models);
-    out.push_back(a);
+    found[i] = a;
   }
+  std::vector<auto_light_settlement> out;
+  for (const auto& a : found)
+    if (a) out.push_back(*a);
   return out;
 }
 

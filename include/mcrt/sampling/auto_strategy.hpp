@@ -192,6 +192,51 @@ struct auto_costs {
 struct auto_receiver {
   vec3 p, n;
 };
+// The box about a set of receivers, for a screen's one test of a group
+// (planar_rule::area_wins_beyond).
+struct auto_receiver_bounds {
+  vec3 lo{std::numeric_limits<float>::infinity()}, hi{-std::numeric_limits<float>::infinity()};
+};
+// A set of receivers in groups of `group` neighbours (in the order of a
+// Morton curve through their box), each with its box: a screen tests a
+// light against a group's box once, and against the receivers of the
+// groups that bound does not settle (auto_sampler::cheapest_at_every).
+// One box about all receivers would be too coarse: a scene's lights lie
+// inside the box of the surfaces it sees.
+struct auto_receiver_groups {
+  static constexpr std::size_t group = 8;
+  std::vector<auto_receiver> receivers;     // reordered
+  std::vector<auto_receiver_bounds> boxes;  // of receivers [group k, group (k + 1))
+
+  explicit auto_receiver_groups(std::span<const auto_receiver> rs) {
+    auto_receiver_bounds all;
+    for (const auto_receiver& r : rs) all.lo = glm::min(all.lo, r.p), all.hi = glm::max(all.hi, r.p);
+    // 10 bits per axis, interleaved.
+    const auto spread = [](std::uint32_t x) {
+      x &= 0x3ffu;
+      x = (x | (x << 16)) & 0x030000ffu;
+      x = (x | (x << 8)) & 0x0300f00fu;
+      x = (x | (x << 4)) & 0x030c30c3u;
+      return (x | (x << 2)) & 0x09249249u;
+    };
+    const vec3 extent = glm::max(all.hi - all.lo, vec3(std::numeric_limits<float>::min()));
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> keys(rs.size());
+    for (std::size_t i = 0; i < rs.size(); ++i) {
+      const vec3 q = glm::clamp((rs[i].p - all.lo) / extent, 0.0f, 1.0f) * 1023.0f;
+      keys[i] = {spread(std::uint32_t(q.x)) | (spread(std::uint32_t(q.y)) << 1) | (spread(std::uint32_t(q.z)) << 2),
+                 static_cast<std::uint32_t>(i)};
+    }
+    std::sort(keys.begin(), keys.end());
+    receivers.reserve(rs.size());
+    for (const auto& k : keys) receivers.push_back(rs[k.second]);
+    for (std::size_t first = 0; first < receivers.size(); first += group) {
+      auto_receiver_bounds b;
+      for (std::size_t i = first; i < std::min(first + group, receivers.size()); ++i)
+        b.lo = glm::min(b.lo, receivers[i].p), b.hi = glm::max(b.hi, receivers[i].p);
+      boxes.push_back(b);
+    }
+  }
+};
 
 // The variance model at one point: v_area and v_sa from the geometry at the
 // quadrature points, then the choice. add() takes a point of the light p
@@ -415,6 +460,7 @@ class planar_rule {
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) set(fine_, k++, r.corner + x[i] * r.e1 + x[j] * r.e2, w[i] * w[j]);
     for (; k < fine_points; ++k) set(fine_, k, center_, 0.0f);
+    reach_ = 0.5f * std::max(glm::length(r.e1 + r.e2), glm::length(r.e1 - r.e2));
   }
   explicit planar_rule(const ellipse& e, const auto_costs::shape_costs& c = auto_costs::ellipse)
       : costs_(c), center_(e.center), E1_(e.a1), E2_(e.a2), nl_(e.n), k_(0.25f),
@@ -438,6 +484,7 @@ class planar_rule {
     k = 0;
     for (int ring = 0; ring < 3; ++ring)
       for (int i = 0; i < 4; ++i) set(fine_, k++, e.center + rho[ring] * (ring == 1 ? diagonal_dirs[i] : axis_dirs[i]), w[ring]);
+    reach_ = semi;
   }
   // A triangle (its back side where `back`, the other half of a two-sided
   // light). The delta method's E1, E2 are the edges of the rectangle with
@@ -451,6 +498,8 @@ class planar_rule {
       : costs_(c), k_(1.0f / 12.0f), area_(t.area()), kind_(kind::triangle), exact_(triangle_projected_solid_angle_sampler(t, back)) {
     const vec3 v[3] = {t.vertex(0), t.vertex(1), t.vertex(2)};
     center_ = (v[0] + v[1] + v[2]) / 3.0f;
+    reach_ = std::sqrt(std::max({glm::dot(v[0] - center_, v[0] - center_), glm::dot(v[1] - center_, v[1] - center_),
+                                 glm::dot(v[2] - center_, v[2] - center_)}));
     nl_ = back ? -t.normal() : t.normal();
     corner_ = center_;
     // The covariance in a frame of the plane, then its principal axes.
@@ -771,8 +820,34 @@ class planar_rule {
   }
   // Whether choose's first two tests (the delta method, then the coarse
   // model) take area sampling at (o, n), before the fine model.
+  // (A bound needing no model comes first: area_wins_beyond at o's
+  // distance from the light's bounding sphere.)
   bool takes_area_before_fine(const vec3& o, const vec3& n, const auto_params& p) const {
-    return first_test_takes_area(o, n, p) || coarse(o, n).area_wins_even_if(4.0f, costs_, p);
+    return area_wins_beyond(glm::length(o - center_) - reach_, p) || first_test_takes_area(o, n, p) ||
+           coarse(o, n).area_wins_even_if(4.0f, costs_, p);
+  }
+  // Whether area sampling wins at every receiver at least `dist` from
+  // every point of the light, by a bound rather than a model: with g =
+  // cos+(theta) cos(theta_l) / r^2 <= 1 / dist^2 at each point of the light,
+  // area sampling's relative variance v satisfies v Omega_proj^2 <= (v + 1)
+  // Omega_proj^2 = A^2 E_A[g^2] <= A^2 / dist^4, so that v / v_rest = v
+  // (rho L Omega_proj / pi)^2 / V <= (rho L A / (pi dist^2))^2 / V
+  // (auto_params::rest_variance_at) whatever the receiver's normal. Where
+  // area sampling wins even at twice that (the first test's margin) against
+  // variance-free alternatives, it is the choice. Only with v_rest from the
+  // image's noise (image_variance > 0); false where dist <= 0.
+  bool area_wins_beyond(float dist, const auto_params& p) const {
+    if (!(p.image_variance > 0.0f) || !(dist > 0.0f)) return false;
+    const float d = p.albedo * p.radiance * area_ * inv_pi / (dist * dist);
+    const float w = d * d / p.image_variance;
+    return w < 1e30f && auto_choice::area_wins(2.0f * w, 1.0f, costs_, p);
+  }
+  // The least distance from the light to a point of the box b (a bound:
+  // the distance from the light's bounding sphere about its centre; <= 0
+  // where they meet).
+  float distance_beyond(const auto_receiver_bounds& b) const {
+    const vec3 d = glm::max(glm::max(b.lo - center_, center_ - b.hi), vec3(0.0f));
+    return glm::length(d) - reach_;
   }
 
  private:
@@ -951,6 +1026,7 @@ class planar_rule {
   vec3 center_, E1_, E2_, nl_;
   float k_;
   float area_;  // the light's area
+  float reach_ = 0.0f;  // the largest distance from the centre to a point of the light
   float coarse_spacing_ = 0.0f, fine_spacing_ = 0.0f;  // largest distance between neighbouring points of each rule
   enum class kind : std::uint8_t { rect, ellipse, triangle };
   kind kind_;
@@ -1089,6 +1165,25 @@ class tabulated_planar_rule {
       if (!rule_.takes_area_before_fine(r.p, r.n, params_)) return false;
     return true;
   }
+  // The same over receiver groups: a group whose box is far enough that
+  // area sampling wins at any point of it by the bound alone
+  // (planar_rule::area_wins_beyond, which each receiver's own tests take
+  // first) passes without its receivers' tests.
+  // With params p in place of the rule's own (the rule's tests depend on the
+  // light and p alone: no rule needs building to screen a light with new
+  // params).
+  bool cheapest_at_every(const auto_receiver_groups& g) const { return cheapest_at_every(g, params_); }
+  bool cheapest_at_every(const auto_receiver_groups& g, const auto_params& p) const {
+    if (rule_.symmetric()) return false;
+    for (std::size_t k = 0; k < g.boxes.size(); ++k) {
+      if (rule_.area_wins_beyond(rule_.distance_beyond(g.boxes[k]), p)) continue;
+      const std::size_t first = k * auto_receiver_groups::group;
+      const std::size_t last = std::min(first + auto_receiver_groups::group, g.receivers.size());
+      for (std::size_t i = first; i < last; ++i)
+        if (!rule_.takes_area_before_fine(g.receivers[i].p, g.receivers[i].n, p)) return false;
+    }
+    return true;
+  }
   // The light's own noise at the model's point with its cheapest strategy
   // (area sampling), relative to the image's: v_area / v_rest = D^2 v_area
   // / V, its share of V at the point (0 where it gives nothing).
@@ -1135,6 +1230,8 @@ class tabulated_sphere_rule {
   }
   // No screen for spheres (their rule is a lookup of two numbers).
   bool cheapest_at_every(std::span<const auto_receiver>) const { return false; }
+  bool cheapest_at_every(const auto_receiver_groups&) const { return false; }
+  bool cheapest_at_every(const auto_receiver_groups&, const auto_params&) const { return false; }
   // As tabulated_planar_rule::noise_share, with the cone (v_sa).
   float noise_share(const auto_choice& m) const { return m.v_solid_angle() / m.rest_variance(params_); }
   float cheapest_cost() const {
@@ -1230,6 +1327,12 @@ struct auto_sampler {
   // sampling: 0.53 s). Triangles only (false for rectangles, ellipses and
   // spheres, whose gate is table_gain's).
   bool cheapest_at_every(std::span<const auto_receiver> rs) const { return rule_.cheapest_at_every(rs); }
+  // The same over the receivers in groups (built once for many lights).
+  bool cheapest_at_every(const auto_receiver_groups& g) const { return rule_.cheapest_at_every(g); }
+  // ... and as if its params were p (what with_params(p) would screen).
+  bool cheapest_at_every(const auto_receiver_groups& g, const auto_params& p) const {
+    return rule_.cheapest_at_every(g, p);
+  }
   // The shape's cheapest strategy (area for planar lights, the cone for
   // spheres), whose sampler is the member area or solid_angle.
   light_sampling cheapest() const { return rule_.cheapest(); }
