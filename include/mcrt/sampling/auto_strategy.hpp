@@ -59,6 +59,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <span>
 #include <tuple>
 #include <utility>
@@ -1140,29 +1141,29 @@ class tabulated_planar_rule {
 
   // The fine rule's model at (o, n): what gain and noise_share weigh. It
   // depends on the light and the point alone, not on the params.
-  auto_choice model(const vec3& o, const vec3& n) const { return rule_.fine(o, n); }
+  auto_choice model(const vec3& o, const vec3& n) const { return rule_->fine(o, n); }
   // The modelled gain (auto_choice::score, the fine rule's model m at o) of
   // the table's choice at (o, n), its lookup's cost included, over the
   // cheapest strategy (area sampling).
   float gain(const auto_choice& m, const vec3& o, const vec3& n) const {
-    const auto_costs::shape_costs& c = rule_.costs();
+    const auto_costs::shape_costs& c = rule_->costs();
     return m.score_of(auto_choice::cheapest(c), 0.0f, c, params_) -
            m.score_of(choose(o, n), auto_costs::table_lookup, c, params_);
   }
-  light_sampling cheapest() const { return auto_choice::cheapest(rule_.costs()); }
+  light_sampling cheapest() const { return auto_choice::cheapest(rule_->costs()); }
   // The fine model m's choice under params p: its modelled noise D^2 v /
   // V (this rule's V) and cost (ns; auto_choice::noise_and_cost).
   std::pair<float, float> modelled(const auto_choice& m, const vec3&, const vec3&, const auto_params& p) const {
-    return m.noise_and_cost(rule_.costs(), p, params_);
+    return m.noise_and_cost(rule_->costs(), p, params_);
   }
   // Whether the rule's tests before its fine model take area sampling (the
   // cheapest) at every receiver: auto_sampler::cheapest_at_every. Triangles
   // only (the lights of meshes, often many; a rectangle's or an ellipse's
   // gate is table_gain's alone).
   bool cheapest_at_every(std::span<const auto_receiver> rs) const {
-    if (rule_.symmetric()) return false;
+    if (rule_->symmetric()) return false;
     for (const auto_receiver& r : rs)
-      if (!rule_.takes_area_before_fine(r.p, r.n, params_)) return false;
+      if (!rule_->takes_area_before_fine(r.p, r.n, params_)) return false;
     return true;
   }
   // The same over receiver groups: a group whose box is far enough that
@@ -1174,13 +1175,13 @@ class tabulated_planar_rule {
   // params).
   bool cheapest_at_every(const auto_receiver_groups& g) const { return cheapest_at_every(g, params_); }
   bool cheapest_at_every(const auto_receiver_groups& g, const auto_params& p) const {
-    if (rule_.symmetric()) return false;
+    if (rule_->symmetric()) return false;
     for (std::size_t k = 0; k < g.boxes.size(); ++k) {
-      if (rule_.area_wins_beyond(rule_.distance_beyond(g.boxes[k]), p)) continue;
+      if (rule_->area_wins_beyond(rule_->distance_beyond(g.boxes[k]), p)) continue;
       const std::size_t first = k * auto_receiver_groups::group;
       const std::size_t last = std::min(first + auto_receiver_groups::group, g.receivers.size());
       for (std::size_t i = first; i < last; ++i)
-        if (!rule_.takes_area_before_fine(g.receivers[i].p, g.receivers[i].n, p)) return false;
+        if (!rule_->takes_area_before_fine(g.receivers[i].p, g.receivers[i].n, p)) return false;
     }
     return true;
   }
@@ -1189,20 +1190,23 @@ class tabulated_planar_rule {
   // / V, its share of V at the point (0 where it gives nothing).
   float noise_share(const auto_choice& m) const { return m.v_area() / m.rest_variance(params_); }
   float cheapest_cost() const {
-    const auto_costs::shape_costs& c = rule_.costs();
+    const auto_costs::shape_costs& c = rule_->costs();
     return std::min({c.area, c.solid_angle, c.projected_solid_angle});
   }
 
  private:
   tabulated_planar_rule(const planar_rule& rule, const vec3& c, const vec3& h1, const vec3& h2, const vec3& nl,
                         const auto_params& p)
-      : rule_(rule), params_(p),
-        table_(c, h1, h2, nl, [rule, p](const vec3& o, const vec3& n) { return rule.choose(o, n, p); }) {}
+      : rule_(std::make_shared<const planar_rule>(rule)), params_(p),
+        table_(c, h1, h2, nl, [r = rule_, p](const vec3& o, const vec3& n) { return r->choose(o, n, p); }) {}
   tabulated_planar_rule(const planar_rule& rule, const auto_params& p)
-      : rule_(rule), params_(p),
+      : rule_(std::make_shared<const planar_rule>(rule)), params_(p),
         table_(rule.centre(), rule.half_scale() * rule.axis1(), rule.half_scale() * rule.axis2(), rule.normal(),
-               [rule, p](const vec3& o, const vec3& n) { return rule.choose(o, n, p); }, rule.symmetric()) {}
-  planar_rule rule_;
+               [r = rule_, p](const vec3& o, const vec3& n) { return r->choose(o, n, p); }, rule.symmetric()) {}
+  // One rule, immutable, shared by the table's cells (which fill from it
+  // lazily) and by copies of this: a light's variant holds a pointer, not
+  // the rule's 680 bytes twice.
+  std::shared_ptr<const planar_rule> rule_;
   auto_params params_;
   planar_auto_table table_;
 };
