@@ -176,7 +176,7 @@ noise_pilot_result low_variance_pilot(Scene& sc, const camera& cam, const render
   // tables' reference counts), their projected samplers in their place.
   std::vector<std::pair<std::size_t, light>> kept;
   kept.reserve(static_cast<std::size_t>(std::count_if(sc.lights.begin(), sc.lights.end(), [](const light& l) {
-    return std::visit([]<class S>(const S&) { return strategy_of<S>() == light_sampling::automatic; }, l);
+    return strategy_of(l) == light_sampling::automatic;
   })));
   for (std::size_t i = 0; i < sc.lights.size(); ++i) {
     std::optional<light> projected;
