@@ -144,6 +144,79 @@ TEST(LightSelection, ChoosesWithTheStatedProbabilities) {
   }
 }
 
+// The one-emitter fast path of pick() and pdf() against the general walk:
+// the same light with a second emitter that cannot be chosen (seen from
+// behind) takes the walk over both, and must give the same light, the same
+// P = 1 and bit for bit the same densities. 20000 random configurations of
+// every strategy kind, by power and uniformly.
+TEST(LightSelection, OneEmitterIsTheGeneralWalk) {
+  pcg32 rng(31, 3);
+  int compared = 0;
+  for (int config = 0; config < 20000; ++config) {
+    std::vector<light> lights{random_light(rng, static_cast<int>(rng.uniform() * 6.0f)),
+                              rect_area_sampler{xz_rect(-1.0f, 1.0f, -1.0f, 1.0f, -3.0f, true)}};  // faces down, below o
+    const std::vector<emitter> one{{0, 0.1f + rng.uniform()}};
+    const std::vector<emitter> two{one[0], {1, 0.1f + rng.uniform()}};
+    const vec3 o{2.0f * rng.uniform() - 1.0f, 0.0f, 2.0f * rng.uniform() - 1.0f};
+    const vec3 n = glm::normalize(vec3{rng.uniform() - 0.5f, 1.0f, rng.uniform() - 0.5f});
+    const light_choice how = rng.uniform() < 0.5f ? light_choice::power : light_choice::uniform;
+    const light_selection fast(lights, one, o, n, how), walk(lights, two, o, n, how);
+    ASSERT_EQ(fast.empty(), walk.empty());
+    if (fast.empty()) continue;
+    const float u = rng.uniform();
+    float p_fast = -1.0f, p_walk = -2.0f;
+    ASSERT_EQ(fast.pick(u, p_fast), 0);
+    ASSERT_EQ(walk.pick(u, p_walk), 0);
+    EXPECT_EQ(p_fast, 1.0f);
+    EXPECT_EQ(p_walk, 1.0f);
+    EXPECT_EQ(walk.probability(1), 0.0f);
+    light_sample s;
+    if (!sample(lights[0], o, n, rng.uniform2(), s)) continue;
+    EXPECT_EQ(fast.pdf(s.dir), walk.pdf(s.dir)) << "config " << config;
+    EXPECT_EQ(fast.pdf(s.dir, 0, s.pdf), walk.pdf(s.dir, 0, s.pdf));
+    const vec3 other = glm::normalize(vec3{rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f});
+    EXPECT_EQ(fast.pdf(other), walk.pdf(other));
+    ++compared;
+  }
+  EXPECT_GT(compared, 10000);
+}
+
+// Without a light tree, the walk keeps which emitters face the point for the
+// first 64 and asks the others again: with 70 emitters, every third facing
+// away (among them emitters 64 to 69), no light facing away is ever chosen
+// or given a probability, the probabilities sum to 1, and what pick()
+// returns is what probability() says.
+TEST(LightSelection, FacingBeyondTheKeptMask) {
+  std::vector<light> lights;
+  std::vector<emitter> emitters;
+  for (int i = 0; i < 70; ++i) {
+    const float x = -3.5f + 0.1f * static_cast<float>(i);
+    lights.push_back(rect_area_sampler{xz_rect(x, x + 0.05f, -0.1f, 0.1f, 2.0f, /*flip=*/i % 3 != 1)});
+    emitters.push_back({static_cast<std::uint32_t>(i), 1.0f + 0.01f * static_cast<float>(i)});
+  }
+  const vec3 o{0.0f, 0.0f, 0.0f}, n{0.0f, 1.0f, 0.0f};
+  for (const light_choice how : {light_choice::power, light_choice::uniform}) {
+    const light_selection sel(lights, emitters, o, n, how);
+    double total = 0.0;
+    for (std::size_t k = 0; k < 70; ++k) {
+      if (k % 3 == 1) {
+        EXPECT_EQ(sel.probability(k), 0.0f) << k;
+      } else {
+        EXPECT_GT(sel.probability(k), 0.0f) << k;
+      }
+      total += sel.probability(k);
+    }
+    EXPECT_NEAR(total, 1.0, 1e-5);
+    for (int i = 0; i < 1000; ++i) {
+      float p = 0.0f;
+      const std::ptrdiff_t k = sel.pick((static_cast<float>(i) + 0.5f) / 1000.0f, p);
+      ASSERT_GE(k, 0);
+      EXPECT_NE(k % 3, 1) << "light " << k << " faces away";
+      EXPECT_EQ(p, sel.probability(static_cast<std::size_t>(k)));
+    }
+  }
+}
+
 TEST(LightSelection, NonEmittingImportanceTargetsAreNotEmitters) {
   scene sc;
   sc.materials = {lambertian{color(0.5f)}, diffuse_light{color(4.0f)}, dielectric{1.5f}};

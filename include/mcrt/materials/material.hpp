@@ -57,6 +57,11 @@ using material =
 // The BSDF of a material that has one (pbrt-v4's conductor and dielectric)
 // at a hit, passed to f; false for the others (Shirley's materials,
 // diffuse ones and lights).
+// Whether m has a BSDF (with_bsdf calls its f).
+inline bool has_bsdf(const material& m) {
+  return std::holds_alternative<conductor_material>(m) || std::holds_alternative<dielectric_material>(m);
+}
+
 template <class F>
 inline bool with_bsdf(const material& m, const hit_record& rec, F&& f) {
   if (const auto* c = std::get_if<conductor_material>(&m)) {

@@ -82,10 +82,11 @@ class light_selection {
     }
     if (hierarchical && emitters.size() > 1)
       throw std::logic_error("light_selection: bvh needs the scene's light tree (scene::build_light_tree)");
-    for (const emitter& e : emitters_)
-      if (faces(lights_[e.light], o_)) {
+    for (std::size_t i = 0; i < emitters_.size(); ++i)
+      if (faces(lights_[emitters_[i].light], o_)) {
+        if (i < mask_bits) facing_ |= std::uint64_t{1} << i;
         ++count_;
-        total_ += e.power;
+        total_ += emitters_[i].power;
       }
     // By power, lights of zero power are never chosen; when they are all the
     // facing lights, there is nothing to choose.
@@ -94,6 +95,9 @@ class light_selection {
   light_selection(std::span<const light> lights, std::span<const emitter> emitters, const vec3& o, const vec3& n,
                   light_choice how)
       : light_selection(lights, emitters, nullptr, o, n, how) {}
+  // A selection of nothing (empty(), pdf 0 everywhere): a placeholder to
+  // assign a real selection to.
+  light_selection() = default;
 
   template <class Scene>
   light_selection(const Scene& sc, const vec3& o, const vec3& n, light_choice how, bool both_sides = false)
@@ -113,13 +117,19 @@ class light_selection {
   std::ptrdiff_t pick(float u, float& prob) const {
     if (tree_) return pick_tree(u, prob);
     if (count_ == 0) return -1;
+    // One facing emitter (of power > 0 when chosen by power): P = 1, the
+    // loops' answer without them.
+    if (count_ == 1 && emitters_.size() == 1) {
+      prob = 1.0f;
+      return emitters_[0].light;
+    }
     if (how_ == light_choice::uniform) {
       std::size_t k = std::min(static_cast<std::size_t>(u * static_cast<float>(count_)), count_ - 1);
-      for (const emitter& e : emitters_) {
-        if (!faces(lights_[e.light], o_)) continue;
+      for (std::size_t i = 0; i < emitters_.size(); ++i) {
+        if (!facing(i)) continue;
         if (k-- == 0) {
           prob = 1.0f / static_cast<float>(count_);
-          return e.light;
+          return emitters_[i].light;
         }
       }
       return -1;
@@ -130,8 +140,9 @@ class light_selection {
     float acc = 0.0f;
     std::ptrdiff_t last = -1;
     float last_power = 0.0f;
-    for (const emitter& e : emitters_) {
-      if (!(e.power > 0.0f) || !faces(lights_[e.light], o_)) continue;
+    for (std::size_t i = 0; i < emitters_.size(); ++i) {
+      const emitter& e = emitters_[i];
+      if (!(e.power > 0.0f) || !facing(i)) continue;
       acc += e.power;
       last = e.light;
       last_power = e.power;
@@ -145,9 +156,9 @@ class light_selection {
   // not an emitter the selection can choose).
   float probability(std::size_t k) const {
     // Where every light emits, emitter k is light k: no search.
-    if (k < emitters_.size() && emitters_[k].light == k) return tree_ ? probability_tree(k) : probability_of(emitters_[k]);
+    if (k < emitters_.size() && emitters_[k].light == k) return tree_ ? probability_tree(k) : probability_of(k);
     for (std::size_t i = 0; i < emitters_.size(); ++i)
-      if (emitters_[i].light == k) return tree_ ? probability_tree(i) : probability_of(emitters_[i]);
+      if (emitters_[i].light == k) return tree_ ? probability_tree(i) : probability_of(i);
     return 0.0f;
   }
 
@@ -158,9 +169,14 @@ class light_selection {
   float pdf(const vec3& dir, std::ptrdiff_t known = -1, float known_pdf = 0.0f) const {
     if (tree_) return pdf_tree(dir, known, known_pdf);
     if (count_ == 0) return 0.0f;
+    if (count_ == 1 && emitters_.size() == 1) {  // P = 1, as pick
+      const std::size_t k = emitters_[0].light;
+      return static_cast<std::ptrdiff_t>(k) == known ? known_pdf : mcrt::pdf(lights_[k], o_, n_, dir);
+    }
     float sum = 0.0f;
-    for (const emitter& e : emitters_) {
-      const float p = probability_of(e);
+    for (std::size_t i = 0; i < emitters_.size(); ++i) {
+      const emitter& e = emitters_[i];
+      const float p = probability_of(i);
       if (!(p > 0.0f)) continue;
       sum += p * (static_cast<std::ptrdiff_t>(e.light) == known ? known_pdf : mcrt::pdf(lights_[e.light], o_, n_, dir));
     }
@@ -170,9 +186,17 @@ class light_selection {
  private:
   using node = light_bvh::node;
 
-  float probability_of(const emitter& e) const {
-    if (count_ == 0 || !faces(lights_[e.light], o_)) return 0.0f;
-    return how_ == light_choice::uniform ? 1.0f / static_cast<float>(count_) : e.power / total_;
+  // Whether emitter i faces the point: the constructor's answer, kept for
+  // the first mask_bits emitters, so pick and pdf do not ask each light again.
+  static constexpr std::size_t mask_bits = 64;
+  bool facing(std::size_t i) const {
+    return i < mask_bits ? ((facing_ >> i) & 1u) != 0 : faces(lights_[emitters_[i].light], o_);
+  }
+
+  // P(k) of emitter i (its index in emitters_) without the tree.
+  float probability_of(std::size_t i) const {
+    if (count_ == 0 || !facing(i)) return 0.0f;
+    return how_ == light_choice::uniform ? 1.0f / static_cast<float>(count_) : emitters_[i].power / total_;
   }
 
   // ---- through the tree ---------------------------------------------------
@@ -401,11 +425,12 @@ class light_selection {
   std::span<const light> lights_;
   std::span<const emitter> emitters_;
   const light_bvh* tree_ = nullptr;
-  vec3 o_, n_;
-  light_choice how_;
+  vec3 o_{0.0f}, n_{0.0f, 0.0f, 1.0f};
+  light_choice how_ = light_choice::power;
   bool both_sides_ = false;
   std::size_t count_ = 0;
   float total_ = 0.0f;
+  std::uint64_t facing_ = 0;  // bit i: emitter i faces the point (i < mask_bits, without the tree)
 };
 
 }  // namespace mcrt

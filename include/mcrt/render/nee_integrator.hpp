@@ -89,26 +89,31 @@ color sample_direct_light_bsdf(const Scene& sc, const hit_record& rec, const sha
 
 template <class Weights>
 struct next_event_integrator {
-  template <class Scene, class P>
-  static color li(const Scene& sc, ray r, P& ps, const path_settings& set) {
-    color radiance(0.0f), throughput(1.0f);
-    // After a diffuse bounce: the light selection at that point and the
+  // What a path carries from one vertex to the next.
+  struct path_state {
+    color radiance{0.0f}, throughput{1.0f};
+    // After a non-delta bounce: the light selection at that point and the
     // density of the direction the material sampled, for the weight of the
     // emission the direction meets.
     bool after_diffuse = false;
-    light_selection prev_sel(sc, vec3(0.0f), vec3(0.0f, 0.0f, 1.0f), set.choose);
+    light_selection prev_sel;  // read only after_diffuse, which assigns it
     float prev_p_material = 0.0f;
+  };
+
+  template <class Scene, class P>
+  static color li(const Scene& sc, ray r, P& ps, const path_settings& set) {
+    path_state st;
     for (int depth = 0;; ++depth) {
       hit_record rec;
       if (!sc.hit(r, 0.0f, infinity, rec)) {
-        radiance += throughput * sc.background;
+        st.radiance += st.throughput * sc.background;
         break;
       }
       const material* mp = &sc.materials[rec.material];
       if (const auto* l = std::get_if<diffuse_light>(mp)) {
         if (rec.front_face || l->twosided) {
-          const float w = after_diffuse ? Weights::material(set, prev_p_material, prev_sel.pdf(r.d)) : 1.0f;
-          radiance += throughput * l->emit * w;
+          const float w = st.after_diffuse ? Weights::material(set, st.prev_p_material, st.prev_sel.pdf(r.d)) : 1.0f;
+          st.radiance += st.throughput * l->emit * w;
         }
         // A light of Shirley's scenes ends the path; one of a pbrt-v4 scene
         // reflects with its surface's material.
@@ -125,8 +130,8 @@ struct next_event_integrator {
         // Light samples and the continuation leave on the facing side.
         const vec3 p = rec.spawn_origin(n);
         const light_selection sel(sc, p, n, set.choose);
-        radiance += throughput * sample_direct_light<Weights>(sc, p, n, albedo, sel, ps, b, set);
-        if (depth >= set.rr_depth && !survive_roulette(throughput, [&] { return ps.get1d(b + layout::roulette); }))
+        st.radiance += st.throughput * sample_direct_light<Weights>(sc, p, n, albedo, sel, ps, b, set);
+        if (depth >= set.rr_depth && !survive_roulette(st.throughput, [&] { return ps.get1d(b + layout::roulette); }))
           break;
         // The last scattering event of a plain next-event estimator: the
         // continuation could only meet the background or an emitter no
@@ -137,63 +142,72 @@ struct next_event_integrator {
         const float cos_theta = glm::dot(dir, n);
         if (!(cos_theta > 0.0f)) break;
         // f cos / p = (albedo / pi) cos / (cos / pi)
-        throughput *= albedo;
-        after_diffuse = true;
-        prev_sel = sel;
-        prev_p_material = cos_theta * inv_pi;
+        st.throughput *= albedo;
+        st.after_diffuse = true;
+        st.prev_sel = sel;
+        st.prev_p_material = cos_theta * inv_pi;
         r = {p, dir};
         continue;
       }
 
-      // pbrt-v4's conductor and dielectric: a light sample where the BSDF is
-      // not a delta, then the BSDF's own sample.
-      bool scattered = false, absorbed = false;
-      with_bsdf(m, rec, [&](const auto& bsdf) {
-        scattered = true;
-        const shading_frame fr = shading_frame::from_normal_tangent(rec.shading_normal(), rec.dpdu);
-        const vec3 wo = fr.to_local(-glm::normalize(r.d));
-        // The light technique's density with the shading normal on wo's
-        // side, from the point moved off the surface to the side the ray
-        // came from: on an emitter's own surface, its plane's side decides
-        // by more than rounding whether its own light faces the point.
-        // A surface that transmits takes light from both sides of its horizon.
-        constexpr bool transmits = !std::is_same_v<std::decay_t<decltype(bsdf)>, conductor_bsdf>;
-        const light_selection sel(sc, rec.spawn_origin(-r.d), wo.z < 0.0f ? -fr.z : fr.z, set.choose, transmits);
-        if (!bsdf.is_delta())
-          radiance += throughput * sample_direct_light_bsdf<Weights>(sc, rec, fr, wo, bsdf, sel, ps, b, set);
-        if (depth >= set.rr_depth && !survive_roulette(throughput, [&] { return ps.get1d(b + layout::roulette); })) {
-          absorbed = true;
-          return;
-        }
-        bsdf_sample bs;
-        if (!bsdf.sample(wo, ps.get1d(b + layout::material_choice), ps.get2d(b + layout::material), bs) ||
-            !(bs.pdf > 0.0f) || bs.f == color(0.0f)) {
-          absorbed = true;
-          return;
-        }
-        const vec3 wi = glm::normalize(fr.to_world(bs.wi));
-        throughput *= bs.f * (std::abs(bs.wi.z) / bs.pdf);
-        after_diffuse = !bs.delta;
-        if (!bs.delta) {
-          prev_sel = sel;
-          prev_p_material = bs.pdf;
-        }
-        r = {rec.spawn_origin(wi), wi};
-      });
-      if (scattered) {
-        if (absorbed) break;
+      if (has_bsdf(m)) {
+        if (!bsdf_vertex(sc, m, rec, depth, ps, set, st, r)) break;
         continue;
       }
 
-      if (depth >= set.rr_depth && !survive_roulette(throughput, [&] { return ps.get1d(b + layout::roulette); }))
+      if (depth >= set.rr_depth && !survive_roulette(st.throughput, [&] { return ps.get1d(b + layout::roulette); }))
         break;
       specular_scatter sp;
       if (!scatter_specular(m, r, rec, ps, b, sp)) break;
-      throughput *= sp.attenuation;
-      after_diffuse = false;
+      st.throughput *= sp.attenuation;
+      st.after_diffuse = false;
       r = sp.r;
     }
-    return radiance;
+    return st.radiance;
+  }
+
+  // A vertex on pbrt-v4's conductor or dielectric (has_bsdf(m)): a light
+  // sample where the BSDF is not a delta, then the BSDF's own sample, which
+  // becomes r. False when the path ends there (roulette, absorption).
+  // Kept out of li (GCC's and Clang's noinline): the loop of Shirley's
+  // materials stays small enough for its own calls to be inlined.
+  template <class Scene, class P>
+#if defined(__GNUC__) || defined(__clang__)
+  [[gnu::noinline]]
+#endif
+  static bool bsdf_vertex(const Scene& sc, const material& m, const hit_record& rec, int depth, P& ps,
+                          const path_settings& set, path_state& st, ray& r) {
+    const int b = layout::bounce(depth);
+    bool alive = false;
+    with_bsdf(m, rec, [&](const auto& bsdf) {
+      const shading_frame fr = shading_frame::from_normal_tangent(rec.shading_normal(), rec.dpdu);
+      const vec3 wo = fr.to_local(-glm::normalize(r.d));
+      // The light technique's density with the shading normal on wo's
+      // side, from the point moved off the surface to the side the ray
+      // came from: on an emitter's own surface, its plane's side decides
+      // by more than rounding whether its own light faces the point.
+      // A surface that transmits takes light from both sides of its horizon.
+      constexpr bool transmits = !std::is_same_v<std::decay_t<decltype(bsdf)>, conductor_bsdf>;
+      const light_selection sel(sc, rec.spawn_origin(-r.d), wo.z < 0.0f ? -fr.z : fr.z, set.choose, transmits);
+      if (!bsdf.is_delta())
+        st.radiance += st.throughput * sample_direct_light_bsdf<Weights>(sc, rec, fr, wo, bsdf, sel, ps, b, set);
+      if (depth >= set.rr_depth && !survive_roulette(st.throughput, [&] { return ps.get1d(b + layout::roulette); }))
+        return;
+      bsdf_sample bs;
+      if (!bsdf.sample(wo, ps.get1d(b + layout::material_choice), ps.get2d(b + layout::material), bs) ||
+          !(bs.pdf > 0.0f) || bs.f == color(0.0f))
+        return;
+      const vec3 wi = glm::normalize(fr.to_world(bs.wi));
+      st.throughput *= bs.f * (std::abs(bs.wi.z) / bs.pdf);
+      st.after_diffuse = !bs.delta;
+      if (!bs.delta) {
+        st.prev_sel = sel;
+        st.prev_p_material = bs.pdf;
+      }
+      r = {rec.spawn_origin(wi), wi};
+      alive = true;
+    });
+    return alive;
   }
 };
 
