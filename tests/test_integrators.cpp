@@ -144,6 +144,27 @@ TEST(LightSelection, ChoosesWithTheStatedProbabilities) {
   }
 }
 
+// has_bsdf, the integrators' test before their out-of-line BSDF vertex,
+// says yes for exactly the materials with_bsdf hands a BSDF: every
+// alternative of material, default-constructed (a conductor given its
+// complex IOR, which has no default).
+TEST(Materials, HasBsdfIsWhatWithBsdfTakes) {
+  const hit_record rec;
+  const auto one = std::make_shared<const texture>(texture::constant(color(1.0f)));
+  [&]<std::size_t... I>(std::index_sequence<I...>) {
+    (
+        [&] {
+          material m{std::in_place_index<I>};
+          if (auto* c = std::get_if<conductor_material>(&m)) c->eta = c->k = one;
+          bool called = false;
+          const bool taken = with_bsdf(m, rec, [&](const auto&) { called = true; });
+          EXPECT_EQ(taken, called) << "alternative " << I;
+          EXPECT_EQ(has_bsdf(m), taken) << "alternative " << I;
+        }(),
+        ...);
+  }(std::make_index_sequence<std::variant_size_v<material>>{});
+}
+
 // The one-emitter fast path of pick() and pdf() against the general walk:
 // the same light with a second emitter that cannot be chosen (seen from
 // behind) takes the walk over both, and must give the same light, the same

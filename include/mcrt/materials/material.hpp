@@ -57,7 +57,10 @@ using material =
 // The BSDF of a material that has one (pbrt-v4's conductor and dielectric)
 // at a hit, passed to f; false for the others (Shirley's materials,
 // diffuse ones and lights).
-// Whether m has a BSDF (with_bsdf calls its f).
+// Whether m has a BSDF (with_bsdf calls its f): a test the integrators can
+// make before leaving their inlined loop for with_bsdf. It names the same
+// alternatives as with_bsdf (test_integrators checks that they agree on
+// every alternative of material).
 inline bool has_bsdf(const material& m) {
   return std::holds_alternative<conductor_material>(m) || std::holds_alternative<dielectric_material>(m);
 }
