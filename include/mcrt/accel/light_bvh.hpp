@@ -125,6 +125,7 @@ class light_bvh {
     order_.reserve(ids.size());
     slots_.reserve(ids.size());
     build(items, ids, 0, static_cast<std::uint32_t>(ids.size()), none, 0);
+    build_proxies();
   }
 
   // The depth no tree exceeds (the traversals' stacks): past max_depth - 24
@@ -144,8 +145,25 @@ class light_bvh {
     bool all_directions = false;  // emits every way (a sphere): no normal
   };
 
+  // A node's lights as one planar emitter (render/light_selection.hpp,
+  // bvh's weight of a node): their flux spread evenly over the rectangle
+  // (corner, e1, e2) that holds their boxes' corners projected on the plane
+  // through their flux-weighted centroid, normal to their flux-weighted
+  // mean emitting normal. planar is false where there is no such normal
+  // (a sphere among the lights, or normals that cancel to less than half
+  // their flux: the lights face every way).
+  struct proxy {
+    vec3 corner{0.0f}, e1{0.0f}, e2{0.0f};
+    vec3 normal{0.0f, 0.0f, 1.0f};
+    vec3 centre{0.0f};
+    float inv_area = 0.0f;  // 1 / |e1| |e2|
+    float r2 = 0.0f;        // the square of the rectangle's half diagonal
+    bool planar = false;
+  };
+
   bool empty() const { return nodes_.empty(); }
   const std::vector<slot>& slots() const { return slots_; }
+  const std::vector<proxy>& proxies() const { return proxies_; }
   const std::vector<node>& nodes() const { return nodes_; }
   // The items in the leaves' order (a subtree's are contiguous).
   const std::vector<std::uint32_t>& order() const { return order_; }
@@ -241,10 +259,59 @@ class light_bvh {
     return index;
   }
 
+  // Each node's proxy (struct proxy), from its lights' slots.
+  void build_proxies() {
+    proxies_.assign(nodes_.size(), proxy{});
+    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+      const node& nd = nodes_[i];
+      proxy& q = proxies_[i];
+      vec3 normal_sum(0.0f), centre_sum(0.0f);
+      float phi = 0.0f;
+      bool sphere = false;
+      for (std::uint32_t k = nd.first; k < nd.first + nd.count; ++k) {
+        const slot& s = slots_[k];
+        sphere = sphere || s.all_directions;
+        normal_sum += s.phi * s.normal;
+        centre_sum += s.phi * s.centre;
+        phi += s.phi;
+      }
+      if (!(phi > 0.0f)) continue;
+      q.centre = centre_sum / phi;
+      const float len = glm::length(normal_sum);
+      if (sphere || !(len >= 0.5f * phi)) continue;
+      q.normal = normal_sum / len;
+      // A frame of the plane (Duff et al. 2017, "Building an orthonormal
+      // basis, revisited").
+      const vec3& nz = q.normal;
+      const float sign = std::copysign(1.0f, nz.z);
+      const float a = -1.0f / (sign + nz.z), b = nz.x * nz.y * a;
+      const vec3 t(1.0f + sign * nz.x * nz.x * a, sign * b, -sign * nz.x);
+      const vec3 u(b, sign + nz.y * nz.y * a, -nz.y);
+      float t0 = infinity, t1 = -infinity, u0 = infinity, u1 = -infinity;
+      for (std::uint32_t k = nd.first; k < nd.first + nd.count; ++k) {
+        const aabb& box = slots_[k].box;
+        for (int c = 0; c < 8; ++c) {
+          const vec3 v(c & 1 ? box.hi.x : box.lo.x, c & 2 ? box.hi.y : box.lo.y, c & 4 ? box.hi.z : box.lo.z);
+          const float x = glm::dot(v - q.centre, t), y = glm::dot(v - q.centre, u);
+          t0 = std::min(t0, x), t1 = std::max(t1, x), u0 = std::min(u0, y), u1 = std::max(u1, y);
+        }
+      }
+      const float area = (t1 - t0) * (u1 - u0);
+      if (!(area > 0.0f) || !std::isfinite(area)) continue;
+      q.corner = q.centre + t0 * t + u0 * u;
+      q.e1 = (t1 - t0) * t;
+      q.e2 = (u1 - u0) * u;
+      q.inv_area = 1.0f / area;
+      q.r2 = 0.25f * ((t1 - t0) * (t1 - t0) + (u1 - u0) * (u1 - u0));
+      q.planar = true;
+    }
+  }
+
   std::vector<node> nodes_;
   std::vector<std::uint32_t> order_;
   std::vector<std::uint32_t> leaf_of_;
   std::vector<slot> slots_;
+  std::vector<proxy> proxies_;
 };
 
 }  // namespace mcrt

@@ -161,6 +161,14 @@ class light_selection {
     return last;
   }
 
+  // Through the tree: the weight at the point of node `index` of the
+  // scene's light tree (light_bvh::nodes()) by which its parent chooses
+  // it: bvh's estimate of its lights' contribution (contribution_estimate),
+  // pbrt-v4's importance, or its flux or light count. For tools and tests.
+  float node_weight_at(std::uint32_t index) const {
+    return tree_ && index < tree_->nodes().size() ? node_weight(tree_->nodes()[index], index) : 0.0f;
+  }
+
   // P(k) of the light with index k among the scene's lights (0 when it is
   // not an emitter the selection can choose).
   float probability(std::size_t k) const {
@@ -257,22 +265,81 @@ class light_selection {
     return sum;
   }
 
-  // A node's weight at the point under the selection's measure (bvh:
-  // pbrt-v4's importance, with cos+ at a surface that only reflects).
-  float node_weight(const node& nd) const {
+  // The weight at the point of node `index` (nd) under the selection's
+  // measure.
+  float node_weight(const node& nd, std::uint32_t index) const {
     switch (how_) {
       case light_choice::power: return nd.bounds.phi;
       case light_choice::uniform: return static_cast<float>(nd.count);
       case light_choice::pbrt_bvh: return bounds_importance(nd.bounds, o_, n_, true);
       case light_choice::bvh:
-      default: return bounds_importance(nd.bounds, o_, n_, both_sides_);
+      default: return contribution_estimate(nd, index);
     }
+  }
+
+  // bvh's weight of a node: an estimate of its lights' whole unoccluded
+  // contribution to a diffuse receiver at the point, in the unit of the
+  // lights' own weights (leaf_weight), so that every choice weighs like
+  // with like. With r the half diagonal of the node's planar proxy
+  // (light_bvh::proxy) and d the distance to its lights' centroid:
+  //   - d > r: the node as a point light, phi cos(theta_l) cos(theta_r) /
+  //     d^2, with the proxy's normal (a cluster of at most cluster_size
+  //     lights only beyond 2 r);
+  //   - a cluster nearer: the sum of its lights' weights, by which it then
+  //     chooses among them;
+  //   - a larger node nearer: its flux spread over the proxy's rectangle,
+  //     phi Omega_proj+(rectangle) / area by Lambert's formula;
+  //   - pbrt-v4's importance where the lights face every way (no proxy).
+  // The distances (r for the point light, 2 r for a cluster's sum) are the
+  // cheapest that kept the variance at 128 floor points of the many-light
+  // scenes (bench/light_select_floor.cpp, mis): Lambert's formula out to
+  // 4 r, the earlier choice, gave the same variance at 1.1-1.5 times the
+  // selection's time; out to r/2 instead of r, 1.2-3.8 times the variance.
+  // Each is 0 where pbrt-v4's importance, an upper bound of the cosines
+  // over the node, is (cos+ at a surface that only reflects), and a
+  // proxy's estimate is at least 1 % of that importance: its rectangle,
+  // facing one way, could otherwise miss lights of the node that face the
+  // point.
+  // pbrt-v4's importance alone misjudges a large node near the point by
+  // its bounds (cosines taken at their bounds over the box, the distance to
+  // its centre); on an emissive curtain of 12 800 triangles with 27 small
+  // lights (many_lights_mesh) it is 3.5-7 times the curtain's contribution
+  // and 1-57 times the small lights'. The noise-free variance of the
+  // choice (bench/light_select_variance.cpp) fell from 0.34 to 0.036 there,
+  // and 1.5 to 0.29 under 14 994 small lights (docs/light-selection.md).
+  float contribution_estimate(const node& nd, std::uint32_t index) const {
+    const float bound = bounds_importance(nd.bounds, o_, n_, both_sides_);
+    if (!(bound > 0.0f)) return 0.0f;
+    const light_bvh::proxy& q = tree_->proxies()[index];
+    const vec3 v = q.centre - o_;
+    const float d2 = glm::dot(v, v);
+    const bool far = q.planar && d2 > q.r2;
+    if (nd.count <= cluster_size && !(q.planar && d2 > 4.0f * q.r2)) {
+      std::array<float, cluster_size> w;
+      return cluster_weights(nd, w);
+    }
+    if (!q.planar) return bound;
+    float estimate = 0.0f;
+    if (far) {
+      const float inv_d = 1.0f / std::sqrt(d2);
+      const float cos_l = -glm::dot(v, q.normal) * inv_d;
+      const float c = glm::dot(v, n_) * inv_d;
+      const float cos_r = both_sides_ ? std::abs(c) : c;
+      if (cos_l > 0.0f && cos_r > 0.0f) estimate = nd.bounds.phi * cos_l * cos_r / d2;
+    } else if (glm::dot(o_ - q.corner, q.normal) > 0.0f) {
+      const std::array<vec3, 4> r{q.corner, q.corner + q.e1, q.corner + q.e1 + q.e2, q.corner + q.e2};
+      double omega = light_importance_detail::clipped_polygon_projected_solid_angle(r.data(), 4, o_, n_);
+      if (both_sides_) omega += light_importance_detail::clipped_polygon_projected_solid_angle(r.data(), 4, o_, -n_);
+      const double x = double(nd.bounds.phi) * q.inv_area * omega;
+      estimate = x < double(FLT_MAX) ? float(x) : FLT_MAX;
+    }
+    return std::max(estimate, 0.01f * bound);
   }
 
   // The probabilities of an inner node's two children.
   void child_probabilities(const node& nd, std::uint32_t index, float& p1, float& p2) const {
     const std::vector<node>& nodes = tree_->nodes();
-    const float w1 = node_weight(nodes[index + 1]), w2 = node_weight(nodes[nd.second]);
+    const float w1 = node_weight(nodes[index + 1], index + 1), w2 = node_weight(nodes[nd.second], nd.second);
     const float total = w1 + w2;
     if (!(total > 0.0f) || !std::isfinite(total)) {
       p1 = p2 = 0.0f;
@@ -313,7 +380,7 @@ class light_selection {
       }
       if (nd.leaf()) {
         // A tree of one light: chosen where its weight is positive.
-        if (i == 0 && !(node_weight(nd) > 0.0f)) return -1;
+        if (i == 0 && !(node_weight(nd, i) > 0.0f)) return -1;
         prob = p;
         return item(nd.first).light;
       }
@@ -354,7 +421,7 @@ class light_selection {
         if (!(w[c] > 0.0f)) return 0.0f;
         return p * (w[c] / sum);
       }
-      if (nd.leaf()) return (i == 0 && !(node_weight(nd) > 0.0f)) ? 0.0f : p;
+      if (nd.leaf()) return (i == 0 && !(node_weight(nd, i) > 0.0f)) ? 0.0f : p;
       float p1, p2;
       child_probabilities(nd, i, p1, p2);
       p *= path[d - 1] == i + 1 ? p1 : p2;
@@ -416,7 +483,7 @@ class light_selection {
         continue;
       }
       if (nd.leaf()) {
-        if (i == 0 && !(node_weight(nd) > 0.0f)) continue;
+        if (i == 0 && !(node_weight(nd, i) > 0.0f)) continue;
         sum += p * light_pdf(nd.first, dir, known, known_pdf);
         continue;
       }
