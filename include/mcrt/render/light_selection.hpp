@@ -16,16 +16,17 @@
 //     point (render/light_importance.hpp), so P(k) is the product of the
 //     choices on the way to light k. pbrt_bvh is pbrt-v4's BVHLightSampler
 //     as it ships (its importance at every node down to the leaves, a
-//     receiver of either side); bvh is mcrt's: pbrt-v4's importance (with
-//     cos+ at a receiver that only reflects) down to the first node of at
-//     most `cluster_size` lights, and there one choice among them by each
-//     light's own contribution (leaf_weight: as a point light from its
-//     centre with its own normal, or exactly where it is near), instead of
-//     five more binary choices between boxes. A box's importance bounds its
-//     cosines and guesses its distance; near the point, where the
-//     contributions that matter are, that is what misleads the choice, and
-//     the lights' own positions and normals do not (the variance each
-//     leaves: bench/light_select_variance.cpp, docs/light-selection.md).
+//     receiver of either side); bvh is mcrt's: at every node an estimate
+//     of its lights' contribution (contribution_estimate: a planar proxy of
+//     them, or a near cluster's lights' own weights), down to the first
+//     node of at most `cluster_size` lights, and there one choice among
+//     them by each light's own contribution (leaf_weight: as a point light
+//     from its centre with its own normal, or exactly where it is near).
+//     A box's importance bounds its cosines and guesses its distance; near
+//     the point, where the contributions that matter are, that is what
+//     misleads the choice (the variance each leaves: bench/
+//     light_select_variance.cpp and light_select_floor.cpp, docs/
+//     light-selection.md).
 // With at most `linear_limit` emitters (or without the scene's light tree),
 // power and uniform consider only the lights that can offer the point a
 // sample (`faces`: a one-sided light seen from behind is left out, so no
@@ -307,7 +308,15 @@ class light_selection {
   // and 1-57 times the small lights'. The noise-free variance of the
   // choice (bench/light_select_variance.cpp) fell from 0.34 to 0.036 there,
   // and 1.5 to 0.29 under 14 994 small lights (docs/light-selection.md).
-  float contribution_estimate(const node& nd, std::uint32_t index) const {
+  // Where it sums a cluster's weights and `kept` is given, they are left
+  // there (kept->valid), for pick_tree to choose among without forming
+  // them again.
+  struct kept_weights {
+    std::array<float, cluster_size> w;
+    float sum = 0.0f;
+    bool valid = false;
+  };
+  float contribution_estimate(const node& nd, std::uint32_t index, kept_weights* kept = nullptr) const {
     const float bound = bounds_importance(nd.bounds, o_, n_, both_sides_);
     if (!(bound > 0.0f)) return 0.0f;
     const light_bvh::proxy& q = tree_->proxies()[index];
@@ -315,6 +324,11 @@ class light_selection {
     const float d2 = glm::dot(v, v);
     const bool far = q.planar && d2 > q.r2;
     if (nd.count <= cluster_size && !(q.planar && d2 > 4.0f * q.r2)) {
+      if (kept) {
+        kept->sum = cluster_weights(nd, kept->w);
+        kept->valid = true;
+        return kept->sum;
+      }
       std::array<float, cluster_size> w;
       return cluster_weights(nd, w);
     }
@@ -337,9 +351,11 @@ class light_selection {
   }
 
   // The probabilities of an inner node's two children.
-  void child_probabilities(const node& nd, std::uint32_t index, float& p1, float& p2) const {
+  void child_probabilities(const node& nd, std::uint32_t index, float& p1, float& p2,
+                           kept_weights* kept1 = nullptr, kept_weights* kept2 = nullptr) const {
     const std::vector<node>& nodes = tree_->nodes();
-    const float w1 = node_weight(nodes[index + 1], index + 1), w2 = node_weight(nodes[nd.second], nd.second);
+    const float w1 = kept1 ? contribution_estimate(nodes[index + 1], index + 1, kept1) : node_weight(nodes[index + 1], index + 1);
+    const float w2 = kept2 ? contribution_estimate(nodes[nd.second], nd.second, kept2) : node_weight(nodes[nd.second], nd.second);
     const float total = w1 + w2;
     if (!(total > 0.0f) || !std::isfinite(total)) {
       p1 = p2 = 0.0f;
@@ -367,11 +383,16 @@ class light_selection {
     const std::vector<node>& nodes = tree_->nodes();
     std::uint32_t i = 0;
     float p = 1.0f;
+    // bvh: a cluster's weights formed for its parent's choice (header of
+    // contribution_estimate), for each child.
+    std::array<kept_weights, 2> kept;
+    const kept_weights* chosen = nullptr;
     for (;;) {
       const node& nd = nodes[i];
       if (is_cluster(nd)) {
         std::array<float, cluster_size> w;
-        const float sum = cluster_weights(nd, w);
+        const float sum = chosen && chosen->valid ? chosen->sum : cluster_weights(nd, w);
+        if (chosen && chosen->valid) w = chosen->w;
         if (!(sum > 0.0f) || !std::isfinite(sum)) return -1;
         const int c = choose_in(w, nd.count, sum, u);
         if (c < 0) return -1;
@@ -385,7 +406,11 @@ class light_selection {
         return item(nd.first).light;
       }
       float p1, p2;
-      child_probabilities(nd, i, p1, p2);
+      kept[0].valid = kept[1].valid = false;
+      if (how_ == light_choice::bvh)
+        child_probabilities(nd, i, p1, p2, &kept[0], &kept[1]);
+      else
+        child_probabilities(nd, i, p1, p2);
       if (!(p1 > 0.0f) && !(p2 > 0.0f)) return -1;
       // u is reused below, rescaled to [0, 1) within the branch taken.
       constexpr float one_minus_epsilon = 0x1.fffffep-1f;
@@ -393,10 +418,12 @@ class light_selection {
         u = std::min(u / p1, one_minus_epsilon);
         p *= p1;
         i = i + 1;
+        chosen = &kept[0];
       } else {
         u = std::min((u - p1) / p2, one_minus_epsilon);
         p *= p2;
         i = nd.second;
+        chosen = &kept[1];
       }
     }
   }
@@ -463,6 +490,10 @@ class light_selection {
     std::size_t top = 0;
     if (meets(nodes[0].bounds.box, inv_d)) stack[top++] = {0, 1.0f};
     float sum = 0.0f;
+    // bvh: the first child's cluster weights, formed for its parent's
+    // choice, as in pick_tree (it is the next node taken off the stack).
+    kept_weights kept, unused;
+    std::uint32_t kept_node = light_bvh::none;
     // Every node on the stack has a box the ray meets.
     while (top > 0) {
       const auto [i, p] = stack[--top];
@@ -474,7 +505,12 @@ class light_selection {
           const std::uint32_t slot = nd.first + c;
           if (nd.count > 1 && !meets(tree_->slots()[slot].box, inv_d)) continue;
           if (total < 0.0f) {
-            total = cluster_weights(nd, w);
+            if (i == kept_node && kept.valid) {
+              w = kept.w;
+              total = kept.sum;
+            } else {
+              total = cluster_weights(nd, w);
+            }
             if (!(total > 0.0f) || !std::isfinite(total)) break;
           }
           if (!(w[c] > 0.0f)) continue;
@@ -491,7 +527,13 @@ class light_selection {
       const bool met1 = meets(nodes[i + 1].bounds.box, inv_d), met2 = meets(nodes[nd.second].bounds.box, inv_d);
       if (!met1 && !met2) continue;
       float p1, p2;
-      child_probabilities(nd, i, p1, p2);
+      kept.valid = false;
+      if (how_ == light_choice::bvh) {
+        child_probabilities(nd, i, p1, p2, &kept, &unused);
+        kept_node = i + 1;
+      } else {
+        child_probabilities(nd, i, p1, p2);
+      }
       if (met2 && p2 > 0.0f) stack[top++] = {nd.second, p * p2};
       if (met1 && p1 > 0.0f) stack[top++] = {i + 1, p * p1};
     }
