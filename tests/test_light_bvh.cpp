@@ -30,6 +30,19 @@ struct light_set {
   light_bvh tree;
 };
 
+// Adds light l of the given radiance as an emitter of its flux.
+void add_emitter(light_set& s, const light& l, float radiance) {
+  s.emitters.push_back({static_cast<std::uint32_t>(s.lights.size()), pi * surface_area(l) * radiance});
+  s.lights.push_back(l);
+}
+
+// The hierarchy over the set's emitters (as scene::build_light_tree).
+void build_tree(light_set& s) {
+  std::vector<light_bounds> items;
+  for (const emitter& e : s.emitters) items.push_back(bounds_of(s.lights[e.light], e.power));
+  s.tree = light_bvh(items);
+}
+
 vec3 random_unit(pcg32& rng) {
   const float z = 2.0f * rng.uniform() - 1.0f, phi = two_pi * rng.uniform();
   const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
@@ -72,13 +85,9 @@ light_set make_lights(int n, std::uint64_t seed, float spread = 4.0f) {
       default: l = sphere_cone_sampler{sphere{c, 0.5f * size}}; break;
     }
     if (kind < 4) ++t;
-    const float radiance = std::pow(10.0f, 4.0f * rng.uniform() - 2.0f);
-    s.emitters.push_back({static_cast<std::uint32_t>(s.lights.size()), pi * surface_area(l) * radiance});
-    s.lights.push_back(l);
+    add_emitter(s, l, std::pow(10.0f, 4.0f * rng.uniform() - 2.0f));
   }
-  std::vector<light_bounds> items;
-  for (const emitter& e : s.emitters) items.push_back(bounds_of(s.lights[e.light], e.power));
-  s.tree = light_bvh(items);
+  build_tree(s);
   return s;
 }
 
@@ -390,15 +399,9 @@ light_set two_panels(int k, float b_radiance, float gap, bool upright = false) {
       }
   }
   const std::vector<triangle> tris = triangles_of(s.mesh);
-  for (std::size_t t = 0; t < tris.size(); ++t) {
-    const light l = triangle_area_sampler{tris[t], false};
-    const float radiance = t < tris.size() / 2 ? 1.0f : b_radiance;
-    s.emitters.push_back({static_cast<std::uint32_t>(s.lights.size()), pi * surface_area(l) * radiance});
-    s.lights.push_back(l);
-  }
-  std::vector<light_bounds> items;
-  for (const emitter& e : s.emitters) items.push_back(bounds_of(s.lights[e.light], e.power));
-  s.tree = light_bvh(items);
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    add_emitter(s, triangle_area_sampler{tris[t], false}, t < tris.size() / 2 ? 1.0f : b_radiance);
+  build_tree(s);
   return s;
 }
 

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "mcrt/core/math.hpp"
+#include "mcrt/core/onb.hpp"
 #include "mcrt/geometry/aabb.hpp"
 
 namespace mcrt {
@@ -280,13 +281,9 @@ class light_bvh {
       const float len = glm::length(normal_sum);
       if (sphere || !(len >= 0.5f * phi)) continue;
       q.normal = normal_sum / len;
-      // A frame of the plane (Duff et al. 2017, "Building an orthonormal
-      // basis, revisited").
-      const vec3& nz = q.normal;
-      const float sign = std::copysign(1.0f, nz.z);
-      const float a = -1.0f / (sign + nz.z), b = nz.x * nz.y * a;
-      const vec3 t(1.0f + sign * nz.x * nz.x * a, sign * b, -sign * nz.x);
-      const vec3 u(b, sign + nz.y * nz.y * a, -nz.y);
+      // A frame of the plane.
+      const onb frame(q.normal);
+      const vec3 &t = frame.u, &u = frame.v;
       float t0 = infinity, t1 = -infinity, u0 = infinity, u1 = -infinity;
       for (std::uint32_t k = nd.first; k < nd.first + nd.count; ++k) {
         const aabb& box = slots_[k].box;

@@ -248,12 +248,20 @@ class light_selection {
       b.phi = s.phi;
       return bounds_importance(b, o_, n_, both_sides_);
     }
+    return point_weight(s.phi, v, d2, s.normal, s.all_directions);
+  }
+
+  // Flux phi at v (from the point; d2 = |v|^2) emitting about `normal`
+  // (every way: all_directions) as a point light to a diffuse receiver:
+  // phi cos+(theta_l) cos+(theta_r) / d^2 (|cos theta_r| where the surface
+  // transmits).
+  float point_weight(float phi, const vec3& v, float d2, const vec3& normal, bool all_directions = false) const {
     const float inv_d = 1.0f / std::sqrt(d2);
-    const float cos_l = s.all_directions ? 1.0f : -glm::dot(v, s.normal) * inv_d;
+    const float cos_l = all_directions ? 1.0f : -glm::dot(v, normal) * inv_d;
     const float c = glm::dot(v, n_) * inv_d;
     const float cos_r = both_sides_ ? std::abs(c) : c;
     if (!(cos_l > 0.0f) || !(cos_r > 0.0f)) return 0.0f;
-    return s.phi * cos_l * cos_r / d2;
+    return phi * cos_l * cos_r / d2;
   }
 
   // A cluster's lights' weights (w[i] for slot first + i) and their sum.
@@ -266,15 +274,24 @@ class light_selection {
     return sum;
   }
 
+  // A cluster's weights and their sum as bvh formed them for its parent's
+  // choice (contribution_estimate), for the choice within it, so that they
+  // are not formed again.
+  struct kept_weights {
+    std::array<float, cluster_size> w;
+    float sum = 0.0f;
+    bool valid = false;
+  };
+
   // The weight at the point of node `index` (nd) under the selection's
-  // measure.
-  float node_weight(const node& nd, std::uint32_t index) const {
+  // measure; bvh leaves a cluster's weights in `kept` where it forms them.
+  float node_weight(const node& nd, std::uint32_t index, kept_weights* kept = nullptr) const {
     switch (how_) {
       case light_choice::power: return nd.bounds.phi;
       case light_choice::uniform: return static_cast<float>(nd.count);
       case light_choice::pbrt_bvh: return bounds_importance(nd.bounds, o_, n_, true);
       case light_choice::bvh:
-      default: return contribution_estimate(nd, index);
+      default: return contribution_estimate(nd, index, kept);
     }
   }
 
@@ -308,14 +325,6 @@ class light_selection {
   // and 1-57 times the small lights'. The noise-free variance of the
   // choice (bench/light_select_variance.cpp) fell from 0.34 to 0.036 there,
   // and 1.5 to 0.29 under 14 994 small lights (docs/light-selection.md).
-  // Where it sums a cluster's weights and `kept` is given, they are left
-  // there (kept->valid), for pick_tree to choose among without forming
-  // them again.
-  struct kept_weights {
-    std::array<float, cluster_size> w;
-    float sum = 0.0f;
-    bool valid = false;
-  };
   float contribution_estimate(const node& nd, std::uint32_t index, kept_weights* kept = nullptr) const {
     const float bound = bounds_importance(nd.bounds, o_, n_, both_sides_);
     if (!(bound > 0.0f)) return 0.0f;
@@ -335,11 +344,7 @@ class light_selection {
     if (!q.planar) return bound;
     float estimate = 0.0f;
     if (far) {
-      const float inv_d = 1.0f / std::sqrt(d2);
-      const float cos_l = -glm::dot(v, q.normal) * inv_d;
-      const float c = glm::dot(v, n_) * inv_d;
-      const float cos_r = both_sides_ ? std::abs(c) : c;
-      if (cos_l > 0.0f && cos_r > 0.0f) estimate = nd.bounds.phi * cos_l * cos_r / d2;
+      estimate = point_weight(nd.bounds.phi, v, d2, q.normal);
     } else if (glm::dot(o_ - q.corner, q.normal) > 0.0f) {
       const std::array<vec3, 4> r{q.corner, q.corner + q.e1, q.corner + q.e1 + q.e2, q.corner + q.e2};
       double omega = light_importance_detail::clipped_polygon_projected_solid_angle(r.data(), 4, o_, n_);
@@ -354,8 +359,8 @@ class light_selection {
   void child_probabilities(const node& nd, std::uint32_t index, float& p1, float& p2,
                            kept_weights* kept1 = nullptr, kept_weights* kept2 = nullptr) const {
     const std::vector<node>& nodes = tree_->nodes();
-    const float w1 = kept1 ? contribution_estimate(nodes[index + 1], index + 1, kept1) : node_weight(nodes[index + 1], index + 1);
-    const float w2 = kept2 ? contribution_estimate(nodes[nd.second], nd.second, kept2) : node_weight(nodes[nd.second], nd.second);
+    const float w1 = node_weight(nodes[index + 1], index + 1, kept1);
+    const float w2 = node_weight(nodes[nd.second], nd.second, kept2);
     const float total = w1 + w2;
     if (!(total > 0.0f) || !std::isfinite(total)) {
       p1 = p2 = 0.0f;
@@ -383,16 +388,19 @@ class light_selection {
     const std::vector<node>& nodes = tree_->nodes();
     std::uint32_t i = 0;
     float p = 1.0f;
-    // bvh: a cluster's weights formed for its parent's choice (header of
-    // contribution_estimate), for each child.
+    // bvh: each child's cluster weights formed for the choice between them
+    // (kept_weights).
     std::array<kept_weights, 2> kept;
     const kept_weights* chosen = nullptr;
     for (;;) {
       const node& nd = nodes[i];
       if (is_cluster(nd)) {
         std::array<float, cluster_size> w;
-        const float sum = chosen && chosen->valid ? chosen->sum : cluster_weights(nd, w);
-        if (chosen && chosen->valid) w = chosen->w;
+        float sum;
+        if (chosen && chosen->valid)
+          w = chosen->w, sum = chosen->sum;
+        else
+          sum = cluster_weights(nd, w);
         if (!(sum > 0.0f) || !std::isfinite(sum)) return -1;
         const int c = choose_in(w, nd.count, sum, u);
         if (c < 0) return -1;
@@ -407,10 +415,7 @@ class light_selection {
       }
       float p1, p2;
       kept[0].valid = kept[1].valid = false;
-      if (how_ == light_choice::bvh)
-        child_probabilities(nd, i, p1, p2, &kept[0], &kept[1]);
-      else
-        child_probabilities(nd, i, p1, p2);
+      child_probabilities(nd, i, p1, p2, &kept[0], &kept[1]);
       if (!(p1 > 0.0f) && !(p2 > 0.0f)) return -1;
       // u is reused below, rescaled to [0, 1) within the branch taken.
       constexpr float one_minus_epsilon = 0x1.fffffep-1f;
@@ -492,7 +497,7 @@ class light_selection {
     float sum = 0.0f;
     // bvh: the first child's cluster weights, formed for its parent's
     // choice, as in pick_tree (it is the next node taken off the stack).
-    kept_weights kept, unused;
+    kept_weights kept;
     std::uint32_t kept_node = light_bvh::none;
     // Every node on the stack has a box the ray meets.
     while (top > 0) {
@@ -528,12 +533,8 @@ class light_selection {
       if (!met1 && !met2) continue;
       float p1, p2;
       kept.valid = false;
-      if (how_ == light_choice::bvh) {
-        child_probabilities(nd, i, p1, p2, &kept, &unused);
-        kept_node = i + 1;
-      } else {
-        child_probabilities(nd, i, p1, p2);
-      }
+      child_probabilities(nd, i, p1, p2, &kept);
+      kept_node = i + 1;
       if (met2 && p2 > 0.0f) stack[top++] = {nd.second, p * p2};
       if (met1 && p1 > 0.0f) stack[top++] = {i + 1, p * p1};
     }
