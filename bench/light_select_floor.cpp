@@ -35,6 +35,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -135,6 +136,7 @@ int main(int argc, char** argv) {
   int used = 0;
   pcg32 point_rng(seed, 7);
   const vec3 n{0.0f, 1.0f, 0.0f};
+  const onb frame(n);  // the material's samples about n
   for (int i = 0; i < points; ++i) {
     const vec3 o{18.0f * (point_rng.uniform() - 0.5f), 1e-4f, 18.0f * (point_rng.uniform() - 0.5f)};
     moments m[2][ns];
@@ -143,9 +145,10 @@ int main(int argc, char** argv) {
       const selector& s = selectors[q];
       pcg32 rng(seed * 1000003u + static_cast<std::uint64_t>(i), 11);  // the same numbers for every selection
       const light_selection sel(sc, o, n, s.how);
-      const exact_selection ex = s.exact ? exact_selection(sc, o, n) : exact_selection(scene{}, o, n);
+      std::optional<exact_selection> ex;
+      if (s.exact) ex.emplace(sc, o, n);
       const auto p_light = [&](const vec3& dir, std::ptrdiff_t k, float pk) {
-        return s.exact ? ex.pdf(sc, o, n, dir) : double(sel.pdf(dir, k, pk));
+        return ex ? ex->pdf(sc, o, n, dir) : double(sel.pdf(dir, k, pk));
       };
       for (int j = 0; j < samples; ++j) {
         const float u0 = rng.uniform();
@@ -155,8 +158,8 @@ int main(int argc, char** argv) {
         double prob = 0.0;
         float probf = 0.0f;
         std::ptrdiff_t k = -1;
-        if (s.exact) {
-          if (!ex.empty()) k = ex.pick(u0, prob);
+        if (ex) {
+          if (!ex->empty()) k = ex->pick(u0, prob);
         } else if (!sel.empty()) {
           k = sel.pick(sel.needs_choice() ? u0 : 0.0f, probf);
         }
@@ -172,13 +175,12 @@ int main(int argc, char** argv) {
           }
         }
         // The material's sample (cosine-weighted), for mis.
-        const float r = std::sqrt(ub.x), phi = 2.0f * pi * ub.y;
-        const vec3 dir = glm::normalize(vec3(r * std::cos(phi), std::sqrt(std::max(0.0f, 1.0f - ub.x)), r * std::sin(phi)));
+        const vec3 dir = glm::normalize(frame.to_world(square_to_cosine_hemisphere(ub)));
         hit_record rec;
         if (sc.hit(ray{o, dir}, 0.0f, infinity, rec)) {
           const double le = channel_mean(emitted(sc.materials[rec.material], rec));
           if (le > 0.0) {
-            const float pb = dir.y * inv_pi;
+            const float pb = square_to_cosine_hemisphere_pdf(frame.to_local(dir));
             const double pl = p_light(dir, -1, 0.0f);
             f_material = le * power_heuristic(pb, float(pl));
           }
