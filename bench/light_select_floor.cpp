@@ -23,9 +23,11 @@
 //
 //   build/mcrt_light_select_floor SCENE.pbrt [--points P] [--samples S]
 //       [--seed K] [--light-sampling area|solid-angle]
+//       [--receivers floor|camera]
 //
-// Receivers: points uniform on the floor y = 0 within |x|, |z| < 9, normal
-// +y (bench/many_lights.py's scenes); points whose every estimate is 0
+// Receivers (bench/receivers.hpp): points uniform on the floor y = 0
+// within |x|, |z| < 9, normal +y (bench/many_lights.py's scenes; the
+// default), or the surfaces the file's camera sees; points whose every estimate is 0
 // (under a box) are left out. Prints per integrator and selection the mean
 // over points of the variance of one estimate, its ratio to power's, and
 // the mean estimate (the same for every selection up to noise: a check).
@@ -41,6 +43,7 @@
 
 #include "mcrt/mcrt.hpp"
 #include "pbrt/builder.hpp"
+#include "receivers.hpp"
 
 using namespace mcrt;
 
@@ -103,12 +106,13 @@ double channel_mean(const color& c) { return (double(c.r) + c.g + c.b) / 3.0; }
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
-                 "usage: %s SCENE.pbrt [--points P] [--samples S] [--seed K] [--light-sampling area|solid-angle]\n",
+                 "usage: %s SCENE.pbrt [--points P] [--samples S] [--seed K] [--light-sampling area|solid-angle] [--receivers floor|camera]\n",
                  argv[0]);
     return 2;
   }
   int points = 128, samples = 256;
   std::uint64_t seed = 1;
+  std::string kind = "floor";
   pbrt::build_options options;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string flag = argv[i], value = argv[i + 1];
@@ -117,6 +121,7 @@ int main(int argc, char** argv) {
     else if (flag == "--seed") seed = std::strtoull(value.c_str(), nullptr, 10);
     else if (flag == "--light-sampling" && value == "solid-angle") options.strategy = light_sampling::solid_angle;
     else if (flag == "--light-sampling" && value == "area") options.strategy = light_sampling::area;
+    else if (flag == "--receivers" && (value == "floor" || value == "camera")) kind = value;
     else {
       std::fprintf(stderr, "%s: unknown option %s %s\n", argv[0], flag.c_str(), value.c_str());
       return 2;
@@ -124,7 +129,8 @@ int main(int argc, char** argv) {
   }
   const pbrt::built_scene b = pbrt::load_pbrt_file(argv[1], options);
   const scene& sc = b.world;
-  std::printf("%s: %zu emitters, %d receivers, %d samples each\n", argv[1], sc.emitters.size(), points, samples);
+  std::printf("%s: %zu emitters, %d receivers (%s), %d samples each\n", argv[1], sc.emitters.size(), points,
+              kind.c_str(), samples);
   const selector selectors[] = {{"power", light_choice::power, false},
                                 {"pbrt-bvh", light_choice::pbrt_bvh, false},
                                 {"bvh", light_choice::bvh, false},
@@ -135,10 +141,10 @@ int main(int argc, char** argv) {
   double seconds[ns] = {};
   int used = 0;
   pcg32 point_rng(seed, 7);
-  const vec3 n{0.0f, 1.0f, 0.0f};
-  const onb frame(n);  // the material's samples about n
-  for (int i = 0; i < points; ++i) {
-    const vec3 o{18.0f * (point_rng.uniform() - 0.5f), 1e-4f, 18.0f * (point_rng.uniform() - 0.5f)};
+  const std::vector<bench::receiver> receivers = bench::make_receivers(b, kind, points, point_rng, 1e-4f);
+  for (int i = 0; i < static_cast<int>(receivers.size()); ++i) {
+    const vec3 o = receivers[static_cast<std::size_t>(i)].o, n = receivers[static_cast<std::size_t>(i)].n;
+    const onb frame(n);  // the material's samples about n
     moments m[2][ns];
     for (int q = 0; q < ns; ++q) {
       const auto start = std::chrono::steady_clock::now();
@@ -192,6 +198,9 @@ int main(int argc, char** argv) {
     }
     if (!(m[0][0].mean() > 0.0 || m[1][0].mean() > 0.0)) continue;
     ++used;
+    if (std::getenv("MCRT_FLOOR_DEBUG"))
+      std::printf("pt %d o %.3f %.3f %.3f n %.2f %.2f %.2f mean %.4g var bvh %.4g exact %.4g pbrt %.4g\n", i, o.x, o.y, o.z, n.x, n.y, n.z,
+                  m[1][2].mean(), m[1][2].variance(), m[1][3].variance(), m[1][1].variance());
     for (int t = 0; t < 2; ++t)
       for (int q = 0; q < ns; ++q) var_sum[t][q] += m[t][q].variance(), mean_sum[t][q] += m[t][q].mean();
   }

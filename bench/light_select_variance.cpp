@@ -9,9 +9,11 @@
 // to the material's sample (its share is reported as "missed").
 //
 //   build/mcrt_light_select_variance SCENE.pbrt [points] [seed]
+//       [--receivers floor|camera]
 //
-// Receivers: points uniform on the floor y = 0 within |x|, |z| < 9, normal
-// +y (bench/many_lights.py's scenes). Prints, per selection, the mean of V
+// Receivers (bench/receivers.hpp): points uniform on the floor y = 0 within
+// |x|, |z| < 9, normal +y (bench/many_lights.py's scenes; the default), or
+// the surfaces the file's camera sees. Prints, per selection, the mean of V
 // and the geometric mean over points of V / V_pbrt-bvh, and the missed share.
 #include <cmath>
 #include <cstdio>
@@ -21,20 +23,37 @@
 
 #include "mcrt/mcrt.hpp"
 #include "pbrt/builder.hpp"
+#include "receivers.hpp"
 
 using namespace mcrt;
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: %s SCENE.pbrt [points] [seed]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s SCENE.pbrt [points] [seed] [--receivers floor|camera]\n", argv[0]);
     return 2;
   }
-  const int points = argc > 2 ? std::atoi(argv[2]) : 256;
-  const std::uint64_t seed = argc > 3 ? std::strtoull(argv[3], nullptr, 10) : 1;
+  int points = 256;
+  std::uint64_t seed = 1;
+  std::string kind = "floor";
+  int positional = 0;
+  for (int i = 2; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--receivers" && i + 1 < argc && (std::string(argv[i + 1]) == "floor" || std::string(argv[i + 1]) == "camera")) {
+      kind = argv[++i];
+    } else if (a.rfind("--", 0) != 0 && positional < 2) {
+      if (positional++ == 0)
+        points = std::atoi(a.c_str());
+      else
+        seed = std::strtoull(a.c_str(), nullptr, 10);
+    } else {
+      std::fprintf(stderr, "%s: unknown argument %s\n", argv[0], a.c_str());
+      return 2;
+    }
+  }
   const pbrt::built_scene b = pbrt::load_pbrt_file(argv[1]);
   const scene& sc = b.world;
   const std::size_t n = sc.emitters.size();
-  std::printf("%s: %zu emitters, %d receivers\n", argv[1], n, points);
+  std::printf("%s: %zu emitters, %d receivers (%s)\n", argv[1], n, points, kind.c_str());
   struct choice {
     const char* name;
     light_choice how;
@@ -42,11 +61,11 @@ int main(int argc, char** argv) {
   const choice choices[] = {{"power", light_choice::power}, {"pbrt-bvh", light_choice::pbrt_bvh}, {"bvh", light_choice::bvh}};
   std::vector<double> sum_v(3, 0.0), sum_log_ratio(3, 0.0), missed(3, 0.0);
   pcg32 rng(seed, 3);
+  const std::vector<bench::receiver> receivers = bench::make_receivers(b, kind, points, rng);
   int used = 0;
   std::vector<double> c(n);
-  for (int i = 0; i < points; ++i) {
-    const vec3 o{18.0f * (rng.uniform() - 0.5f), 0.0f, 18.0f * (rng.uniform() - 0.5f)};
-    const vec3 nrm{0.0f, 1.0f, 0.0f};
+  for (const bench::receiver& rc : receivers) {
+    const vec3 o = rc.o, nrm = rc.n;
     double total = 0.0;
     for (std::size_t k = 0; k < n; ++k) {
       const emitter& e = sc.emitters[k];

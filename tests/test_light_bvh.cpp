@@ -7,6 +7,8 @@
 // light_importance.hpp) against their definitions.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -257,6 +259,10 @@ TEST(LightSelectionTree, ProbabilitiesAndDensitiesAgree) {
         if (how == light_choice::power || how == light_choice::uniform) EXPECT_NEAR(total, 1.0, 2e-5) << name(how);
         if (k < 0) continue;
         EXPECT_EQ(prob, p[static_cast<std::size_t>(k)]) << name(how);
+        // bvh's memo (filled by the calls above) changes no float: a fresh
+        // selection gives the same probability and density.
+        const light_selection fresh(s.lights, s.emitters, &s.tree, o, nrm, how, both);
+        EXPECT_EQ(fresh.probability(static_cast<std::size_t>(k)), prob) << name(how);
         ++tested;
         const auto brute = [&](const vec3& dir) {
           double sum = 0.0;
@@ -269,6 +275,8 @@ TEST(LightSelectionTree, ProbabilitiesAndDensitiesAgree) {
         if (sample(s.lights[static_cast<std::size_t>(k)], o, nrm, rng.uniform2(), ls)) {
           const double ref = brute(ls.dir);
           EXPECT_NEAR(sel.pdf(ls.dir), ref, 1e-5 * ref) << name(how);
+          const light_selection fresh_pdf(s.lights, s.emitters, &s.tree, o, nrm, how, both);
+          EXPECT_EQ(fresh_pdf.pdf(ls.dir), sel.pdf(ls.dir)) << name(how);
           // With the sampled light's density as sample() returned it.
           const double ref_known = ref + double(p[static_cast<std::size_t>(k)]) *
                                              (double(ls.pdf) - pdf(s.lights[static_cast<std::size_t>(k)], o, nrm, ls.dir));
@@ -434,19 +442,20 @@ TEST(LightBvh, ThePlanarProxyOfAPanelIsThePanel) {
   EXPECT_FALSE(mixed.tree.proxies()[0].planar);
 }
 
-// bvh weighs a node near the point by its lights' whole contribution
-// (light_selection::node_weight_at): with the point within a half diagonal
-// of both panels' centres (a floor panel and an upright one at its edge),
-// each panel's weight is the sum of its lights' exact contributions (pi L
+// bvh weighs a node of more than recurse_limit lights near the point by
+// its lights' whole contribution (light_selection::node_weight_at): with
+// the point within a half diagonal of both panels' centres (a floor panel
+// and an upright one at its edge, 288 triangles each), each panel's weight is the sum of its lights' exact contributions (pi L
 // Omega_proj+, Lambert's formula, horizon-clipped), which the proxy's one
 // rectangle gives, for receivers of every orientation. pbrt-v4's
 // importance is off by more than 2x here (checked, so the comparison can
 // fail).
 TEST(LightSelectionTree, BvhWeighsANearPanelByItsContribution) {
-  const light_set s = two_panels(8, 3.0f, 0.1f, true);
+  const light_set s = two_panels(12, 3.0f, 0.1f, true);
   const auto& nodes = s.tree.nodes();
   const std::uint32_t panels[2] = {1u, nodes[0].second};
-  ASSERT_EQ(nodes[panels[0]].count, 128u);
+  ASSERT_EQ(nodes[panels[0]].count, 288u);
+  ASSERT_GT(nodes[panels[0]].count, light_selection::recurse_limit);
   ASSERT_TRUE(s.tree.proxies()[panels[0]].planar && s.tree.proxies()[panels[1]].planar);
   pcg32 rng(21, 5);
   double pbrt_worst = 1.0;
@@ -474,4 +483,88 @@ TEST(LightSelectionTree, BvhWeighsANearPanelByItsContribution) {
   }
   EXPECT_GT(tested, 300);
   EXPECT_GT(pbrt_worst, 2.0);
+}
+
+namespace {
+
+// n small squares (side 0.04) scattered through a slab [0, 2] x [0.2, 2.2]
+// x [0, 2], facing down within 30 degrees, their radiance over two decades:
+// lights spread along their mean normal as much as across it.
+light_set scattered_squares(int n, std::uint64_t seed) {
+  pcg32 rng(seed, 3);
+  light_set s;
+  for (int i = 0; i < n; ++i) {
+    const vec3 c{2.0f * rng.uniform(), 0.2f + 2.0f * rng.uniform(), 2.0f * rng.uniform()};
+    const float theta = 0.52f * rng.uniform(), phi = two_pi * rng.uniform();
+    const vec3 normal{std::sin(theta) * std::cos(phi), -std::cos(theta), std::sin(theta) * std::sin(phi)};
+    const onb frame(normal);
+    // rect::make's normal is e1 x e2: frame.u x frame.v = normal.
+    add_emitter(s, rect_solid_angle_sampler{rect::make(c, 0.04f * frame.u, 0.04f * frame.v)},
+                std::pow(10.0f, 2.0f * rng.uniform()));
+  }
+  build_tree(s);
+  return s;
+}
+
+}  // namespace
+
+// bvh weighs a node of at most recurse_limit lights near the point by the
+// sum of its children's weights: under lights scattered in height, where
+// a proxy (one rectangle, or a point light at the centroid) misjudges the
+// near lights, the weight stays near the node's exact contribution (the
+// sum over its lights of pi L Omega_proj+). Over receivers on the floor
+// below the slab and within it, the relative error is under 1 % at the
+// median and under 10 % at the 95th percentile (measured: 0.08 % and
+// 6.7 %), where the node's planar proxy alone (Lambert's formula over its
+// rectangle) is off by more than 25 % and 100 % (measured: 26 % and 157 %;
+// checked, so the comparison can fail). The weights come from a
+// selection whose memo pick() has filled and equal a fresh selection's.
+TEST(LightSelectionTree, BvhWeighsANearNodeOfScatteredLightsByItsChildren) {
+  const light_set s = scattered_squares(100, 9);
+  const auto& nodes = s.tree.nodes();
+  pcg32 rng(31, 7);
+  std::vector<double> err, proxy_err;
+  for (int i = 0; i < 200; ++i) {
+    const bool floor = i % 2 == 0;
+    const vec3 o{2.0f * rng.uniform(), floor ? 0.0f : 0.2f + 2.0f * rng.uniform(), 2.0f * rng.uniform()};
+    const vec3 nrm = floor ? vec3(0.0f, 1.0f, 0.0f) : random_unit(rng);
+    const light_selection used(s.lights, s.emitters, &s.tree, o, nrm, light_choice::bvh, false);
+    const light_selection fresh(s.lights, s.emitters, &s.tree, o, nrm, light_choice::bvh, false);
+    float prob;
+    (void)used.pick(rng.uniform(), prob);
+    for (std::uint32_t j = 1; j < nodes.size(); ++j) {
+      const auto& nd = nodes[j];
+      const light_bvh::proxy& q = s.tree.proxies()[j];
+      if (nd.count <= light_selection::cluster_size || nd.count > light_selection::recurse_limit || !q.planar) continue;
+      const vec3 v = q.centre - o;
+      if (glm::dot(v, v) > light_selection::recurse_far * q.r2) continue;
+      double exact = 0.0;
+      for (std::uint32_t k = nd.first; k < nd.first + nd.count; ++k) {
+        const std::uint32_t l = s.tree.order()[k];
+        exact += exact_importance(s.lights[l], s.emitters[l].power, o, nrm, false);
+      }
+      const float w = used.node_weight_at(j);
+      EXPECT_EQ(w, fresh.node_weight_at(j));
+      // (Where the node gives nothing, a proxy below it keeps 1 % of
+      // pbrt-v4's bound.)
+      if (!(exact > 0.0)) continue;
+      err.push_back(std::abs(w / exact - 1.0));
+      const std::array<vec3, 4> r{q.corner, q.corner + q.e1, q.corner + q.e1 + q.e2, q.corner + q.e2};
+      const double lambert = glm::dot(o - q.corner, q.normal) > 0.0f
+                                 ? double(nd.bounds.phi) * q.inv_area *
+                                       light_importance_detail::clipped_polygon_projected_solid_angle(r.data(), 4, o, nrm)
+                                 : 0.0;
+      proxy_err.push_back(std::abs(lambert / exact - 1.0));
+    }
+  }
+  ASSERT_GT(err.size(), 100u);
+  const auto quantile = [](std::vector<double> x, double f) {
+    const auto k = static_cast<std::ptrdiff_t>(f * double(x.size()));
+    std::nth_element(x.begin(), x.begin() + k, x.end());
+    return x[static_cast<std::size_t>(k)];
+  };
+  EXPECT_LT(quantile(err, 0.5), 0.01);
+  EXPECT_LT(quantile(err, 0.95), 0.1);
+  EXPECT_GT(quantile(proxy_err, 0.5), 0.25);
+  EXPECT_GT(quantile(proxy_err, 0.95), 1.0);
 }
