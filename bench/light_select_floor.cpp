@@ -198,9 +198,6 @@ int main(int argc, char** argv) {
     }
     if (!(m[0][0].mean() > 0.0 || m[1][0].mean() > 0.0)) continue;
     ++used;
-    if (std::getenv("MCRT_FLOOR_DEBUG"))
-      std::printf("pt %d o %.3f %.3f %.3f n %.2f %.2f %.2f mean %.4g var bvh %.4g exact %.4g pbrt %.4g\n", i, o.x, o.y, o.z, n.x, n.y, n.z,
-                  m[1][2].mean(), m[1][2].variance(), m[1][3].variance(), m[1][1].variance());
     for (int t = 0; t < 2; ++t)
       for (int q = 0; q < ns; ++q) var_sum[t][q] += m[t][q].variance(), mean_sum[t][q] += m[t][q].mean();
   }
