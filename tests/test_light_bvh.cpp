@@ -549,7 +549,7 @@ TEST(LightSelectionTree, BvhWeighsANearNodeOfScatteredLightsByItsChildren) {
       // pbrt-v4's bound.)
       if (!(exact > 0.0)) continue;
       err.push_back(std::abs(w / exact - 1.0));
-      const std::array<vec3, 4> r{q.corner, q.corner + q.e1, q.corner + q.e1 + q.e2, q.corner + q.e2};
+      const std::array<vec3, 4> r = q.corners();
       const double lambert = glm::dot(o - q.corner, q.normal) > 0.0f
                                  ? double(nd.bounds.phi) * q.inv_area *
                                        light_importance_detail::clipped_polygon_projected_solid_angle(r.data(), 4, o, nrm)

@@ -160,6 +160,9 @@ class light_bvh {
     float inv_area = 0.0f;  // 1 / |e1| |e2|
     float r2 = 0.0f;        // the square of the rectangle's half diagonal
     bool planar = false;
+
+    // The rectangle's corners in order around it (corner, + e1, + e1 + e2, + e2).
+    std::array<vec3, 4> corners() const { return {corner, corner + e1, corner + e1 + e2, corner + e2}; }
   };
 
   bool empty() const { return nodes_.empty(); }

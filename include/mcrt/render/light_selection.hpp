@@ -368,7 +368,8 @@ class light_selection {
     const float d2 = glm::dot(v, v);
     const bool recurse = nd.count <= recurse_limit;
     const bool far = q.planar && d2 > (recurse ? recurse_far : 1.0f) * q.r2;
-    if (nd.count <= cluster_size && !(q.planar && d2 > 4.0f * q.r2)) {
+    static_assert(cluster_size <= recurse_limit, "a cluster is weighed as a point light beyond 2 r only");
+    if (nd.count <= cluster_size && !far) {
       if (kept) {
         kept->sum = cluster_weights(nd, kept->w);
         kept->valid = true;
@@ -386,7 +387,7 @@ class light_selection {
       estimate = memoized_estimate(nodes[index + 1], index + 1) + memoized_estimate(nodes[nd.second], nd.second);
       return estimate;
     } else if (glm::dot(o_ - q.corner, q.normal) > 0.0f) {
-      const std::array<vec3, 4> r{q.corner, q.corner + q.e1, q.corner + q.e1 + q.e2, q.corner + q.e2};
+      const std::array<vec3, 4> r = q.corners();
       double omega = light_importance_detail::clipped_polygon_projected_solid_angle(r.data(), 4, o_, n_);
       if (both_sides_) omega += light_importance_detail::clipped_polygon_projected_solid_angle(r.data(), 4, o_, -n_);
       const double x = double(nd.bounds.phi) * q.inv_area * omega;

@@ -23,6 +23,9 @@
 // Dimensions (samplers/layout.hpp) at bounce b: the light choice (drawn
 // only when the scene has more than one emitter), the light sample, the
 // roulette, then the material sample.
+#include <memory>
+#include <type_traits>
+
 #include "mcrt/render/path.hpp"
 
 namespace mcrt {
@@ -98,6 +101,17 @@ struct next_event_integrator {
     bool after_diffuse = false;
     light_selection prev_sel;  // read only after_diffuse, which assigns it
     float prev_p_material = 0.0f;
+
+    // The light selection at this vertex, built where the previous vertex's
+    // was: that one is read only by the emission this vertex's ray met,
+    // which comes before. A selection carries bvh's memo (hundreds of
+    // bytes), so it is built in place rather than copied at each vertex.
+    template <class Scene>
+    const light_selection& select_lights(const Scene& sc, const vec3& o, const vec3& n, light_choice how,
+                                         bool both_sides = false) {
+      static_assert(std::is_trivially_destructible_v<light_selection>);
+      return *std::construct_at(&prev_sel, sc, o, n, how, both_sides);
+    }
   };
 
   template <class Scene, class P>
@@ -129,7 +143,7 @@ struct next_event_integrator {
         const vec3 n = rec.facing_shading_normal(r.d);
         // Light samples and the continuation leave on the facing side.
         const vec3 p = rec.spawn_origin(n);
-        const light_selection sel(sc, p, n, set.choose);
+        const light_selection& sel = st.select_lights(sc, p, n, set.choose);
         st.radiance += st.throughput * sample_direct_light<Weights>(sc, p, n, albedo, sel, ps, b, set);
         if (depth >= set.rr_depth && !survive_roulette(st.throughput, [&] { return ps.get1d(b + layout::roulette); }))
           break;
@@ -143,8 +157,7 @@ struct next_event_integrator {
         if (!(cos_theta > 0.0f)) break;
         // f cos / p = (albedo / pi) cos / (cos / pi)
         st.throughput *= albedo;
-        st.after_diffuse = true;
-        st.prev_sel = sel;
+        st.after_diffuse = true;  // st.prev_sel is sel
         st.prev_p_material = cos_theta * inv_pi;
         r = {p, dir};
         continue;
@@ -188,7 +201,8 @@ struct next_event_integrator {
       // by more than rounding whether its own light faces the point.
       // A surface that transmits takes light from both sides of its horizon.
       constexpr bool transmits = !std::is_same_v<std::decay_t<decltype(bsdf)>, conductor_bsdf>;
-      const light_selection sel(sc, rec.spawn_origin(-r.d), wo.z < 0.0f ? -fr.z : fr.z, set.choose, transmits);
+      const light_selection& sel =
+          st.select_lights(sc, rec.spawn_origin(-r.d), wo.z < 0.0f ? -fr.z : fr.z, set.choose, transmits);
       if (!bsdf.is_delta())
         st.radiance += st.throughput * sample_direct_light_bsdf<Weights>(sc, rec, fr, wo, bsdf, sel, ps, b, set);
       if (depth >= set.rr_depth && !survive_roulette(st.throughput, [&] { return ps.get1d(b + layout::roulette); }))
@@ -199,11 +213,8 @@ struct next_event_integrator {
         return;
       const vec3 wi = glm::normalize(fr.to_world(bs.wi));
       st.throughput *= bs.f * (std::abs(bs.wi.z) / bs.pdf);
-      st.after_diffuse = !bs.delta;
-      if (!bs.delta) {
-        st.prev_sel = sel;
-        st.prev_p_material = bs.pdf;
-      }
+      st.after_diffuse = !bs.delta;  // st.prev_sel is sel
+      if (!bs.delta) st.prev_p_material = bs.pdf;
       r = {rec.spawn_origin(wi), wi};
       alive = true;
     });
