@@ -108,6 +108,7 @@ class light_bvh {
     std::uint32_t first = 0;        // its lights: order()[first, first + count)
     std::uint32_t count = 0;
     std::uint32_t parent = none;
+    aabb ray_box;  // bounds.box widened for ray tests (widened())
     bool leaf() const { return count == 1; }
   };
   static constexpr std::uint32_t none = 0xffffffffu;
@@ -127,6 +128,22 @@ class light_bvh {
     slots_.reserve(ids.size());
     build(items, ids, 0, static_cast<std::uint32_t>(ids.size()), none, 0);
     build_proxies();
+    for (node& nd : nodes_) nd.ray_box = widened(nd.bounds.box);
+    for (slot& s : slots_) s.ray_box = widened(s.box);
+  }
+
+  // A box widened by 1e-6 of its coordinates' magnitudes on each axis, for
+  // the ray tests of light_selection::pdf (which widens it by the ray
+  // origin's magnitude too): a ray that meets a light whose box is flat (a
+  // polygon in a coordinate plane) is not lost to the slab test's rounding.
+  static aabb widened(const aabb& b) {
+    aabb w;
+    for (int a = 0; a < 3; ++a) {
+      const float pad = 1e-6f * (std::abs(b.lo[a]) + std::abs(b.hi[a]));
+      w.lo[a] = b.lo[a] - pad;
+      w.hi[a] = b.hi[a] + pad;
+    }
+    return w;
   }
 
   // The depth no tree exceeds (the traversals' stacks): past max_depth - 24
@@ -144,6 +161,7 @@ class light_bvh {
     float phi = 0.0f;
     float r2 = 0.0f;
     bool all_directions = false;  // emits every way (a sphere): no normal
+    aabb ray_box;                 // box widened for ray tests (widened())
   };
 
   // A node's lights as one planar emitter (render/light_selection.hpp,
@@ -207,7 +225,7 @@ class light_bvh {
       leaf_of_[item] = index;
       const light_bounds& b = items[item];
       const vec3 half = 0.5f * (b.box.hi - b.box.lo);
-      slots_.push_back({b.box, b.centre, b.normals.w, b.phi, glm::dot(half, half), b.normals.cos_theta < 0.0f});
+      slots_.push_back({b.box, b.centre, b.normals.w, b.phi, glm::dot(half, half), b.normals.cos_theta < 0.0f, {}});
       return index;
     }
     light_bounds all;

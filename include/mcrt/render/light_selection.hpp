@@ -503,16 +503,28 @@ class light_selection {
     return 0.0f;
   }
 
-  // Whether the ray from o along the direction with reciprocal inv_d meets
-  // the box, for t >= 0. The box is widened by a few ulp of its coordinates
-  // and the origin's: a ray that meets a light whose box is flat (a polygon
-  // in a coordinate plane) is not lost to the slab test's rounding, and a
-  // slab met edge-on (0 times infinity) is never NaN.
-  bool meets(const aabb& b, const vec3& inv_d) const {
+  // A ray from the point for the slab tests of pdf_tree: the reciprocal of
+  // its direction and the offsets that move a box's faces to the origin,
+  // widened by 1e-6 of the origin's coordinates (the boxes are widened by
+  // 1e-6 of theirs: light_bvh::widened) and by 1e-30 more, so that a slab
+  // met edge-on (0 times infinity) is never NaN.
+  struct slab_ray {
+    vec3 inv_d, lo_off, hi_off;
+    slab_ray(const vec3& o, const vec3& dir) : inv_d(1.0f / dir) {
+      for (int a = 0; a < 3; ++a) {
+        const float pad = 1e-6f * std::abs(o[a]) + 1e-30f;
+        lo_off[a] = -o[a] - pad;
+        hi_off[a] = -o[a] + pad;
+      }
+    }
+  };
+
+  // Whether the ray meets the box widened for ray tests (ray_box of a
+  // light_bvh node or slot), for t >= 0.
+  static bool meets(const aabb& b, const slab_ray& r) {
     float t0 = 0.0f, t1 = infinity;
     for (int a = 0; a < 3; ++a) {
-      const float pad = 1e-6f * (std::abs(b.lo[a]) + std::abs(b.hi[a]) + std::abs(o_[a])) + 1e-30f;
-      float tn = (b.lo[a] - pad - o_[a]) * inv_d[a], tf = (b.hi[a] + pad - o_[a]) * inv_d[a];
+      float tn = (b.lo[a] + r.lo_off[a]) * r.inv_d[a], tf = (b.hi[a] + r.hi_off[a]) * r.inv_d[a];
       if (tn > tf) std::swap(tn, tf);
       t0 = std::max(t0, tn);
       t1 = std::min(t1, tf);
@@ -527,14 +539,14 @@ class light_selection {
 
   float pdf_tree(const vec3& dir, std::ptrdiff_t known, float known_pdf) const {
     const std::vector<node>& nodes = tree_->nodes();
-    const vec3 inv_d = 1.0f / dir;
+    const slab_ray ray(o_, dir);
     struct entry {
       std::uint32_t node;
       float p;
     };
     std::array<entry, light_bvh::max_depth + 2> stack;
     std::size_t top = 0;
-    if (meets(nodes[0].bounds.box, inv_d)) stack[top++] = {0, 1.0f};
+    if (meets(nodes[0].ray_box, ray)) stack[top++] = {0, 1.0f};
     float sum = 0.0f;
     // bvh: the first child's cluster weights, formed for its parent's
     // choice, as in pick_tree (it is the next node taken off the stack).
@@ -549,7 +561,7 @@ class light_selection {
         float total = -1.0f;  // formed only if the ray meets one of the cluster's lights
         for (std::uint32_t c = 0; c < nd.count; ++c) {
           const std::uint32_t slot = nd.first + c;
-          if (nd.count > 1 && !meets(tree_->slots()[slot].box, inv_d)) continue;
+          if (nd.count > 1 && !meets(tree_->slots()[slot].ray_box, ray)) continue;
           if (total < 0.0f) {
             if (i == kept_node && kept.valid) {
               w = kept.w;
@@ -570,7 +582,7 @@ class light_selection {
         continue;
       }
       // The children's probabilities only where the ray meets a child.
-      const bool met1 = meets(nodes[i + 1].bounds.box, inv_d), met2 = meets(nodes[nd.second].bounds.box, inv_d);
+      const bool met1 = meets(nodes[i + 1].ray_box, ray), met2 = meets(nodes[nd.second].ray_box, ray);
       if (!met1 && !met2) continue;
       float p1, p2;
       kept.valid = false;
