@@ -129,7 +129,6 @@ class light_bvh {
     build(items, ids, 0, static_cast<std::uint32_t>(ids.size()), none, 0);
     build_proxies();
     for (node& nd : nodes_) nd.ray_box = widened(nd.bounds.box);
-    for (slot& s : slots_) s.ray_box = widened(s.box);
   }
 
   // A box widened by 1e-6 of its coordinates' magnitudes on each axis, for
@@ -225,7 +224,8 @@ class light_bvh {
       leaf_of_[item] = index;
       const light_bounds& b = items[item];
       const vec3 half = 0.5f * (b.box.hi - b.box.lo);
-      slots_.push_back({b.box, b.centre, b.normals.w, b.phi, glm::dot(half, half), b.normals.cos_theta < 0.0f, {}});
+      slots_.push_back({b.box, b.centre, b.normals.w, b.phi, glm::dot(half, half), b.normals.cos_theta < 0.0f,
+                        widened(b.box)});
       return index;
     }
     light_bounds all;
