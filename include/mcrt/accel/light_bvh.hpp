@@ -108,7 +108,7 @@ class light_bvh {
     std::uint32_t first = 0;        // its lights: order()[first, first + count)
     std::uint32_t count = 0;
     std::uint32_t parent = none;
-    aabb ray_box;  // bounds.box widened for ray tests (widened())
+    aabb ray_box;  // bounds.box widened for ray tests (widened()), holding its children's
     bool leaf() const { return count == 1; }
   };
   static constexpr std::uint32_t none = 0xffffffffu;
@@ -128,7 +128,19 @@ class light_bvh {
     slots_.reserve(ids.size());
     build(items, ids, 0, static_cast<std::uint32_t>(ids.size()), none, 0);
     build_proxies();
-    for (node& nd : nodes_) nd.ray_box = widened(nd.bounds.box);
+    // Children follow their parent, so a walk backwards meets each node's
+    // children before it: an inner node's ray box grows to hold its
+    // children's, and a ray that meets a light's ray box meets every ray box
+    // above it (the slab test is monotone in a box's faces), which lets
+    // light_selection reach a cluster's lights through its subtree.
+    for (std::size_t i = nodes_.size(); i-- > 0;) {
+      node& nd = nodes_[i];
+      nd.ray_box = widened(nd.bounds.box);
+      if (!nd.leaf()) {
+        nd.ray_box.grow(nodes_[i + 1].ray_box);
+        nd.ray_box.grow(nodes_[nd.second].ray_box);
+      }
+    }
   }
 
   // A box widened by 1e-6 of its coordinates' magnitudes on each axis, for
@@ -160,7 +172,6 @@ class light_bvh {
     float phi = 0.0f;
     float r2 = 0.0f;
     bool all_directions = false;  // emits every way (a sphere): no normal
-    aabb ray_box;                 // box widened for ray tests (widened())
   };
 
   // A node's lights as one planar emitter (render/light_selection.hpp,
@@ -224,8 +235,7 @@ class light_bvh {
       leaf_of_[item] = index;
       const light_bounds& b = items[item];
       const vec3 half = 0.5f * (b.box.hi - b.box.lo);
-      slots_.push_back({b.box, b.centre, b.normals.w, b.phi, glm::dot(half, half), b.normals.cos_theta < 0.0f,
-                        widened(b.box)});
+      slots_.push_back({b.box, b.centre, b.normals.w, b.phi, glm::dot(half, half), b.normals.cos_theta < 0.0f});
       return index;
     }
     light_bounds all;

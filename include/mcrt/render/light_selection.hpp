@@ -43,6 +43,7 @@
 // visits only the nodes whose boxes the ray from o along dir meets.
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cfloat>
 #include <cstddef>
 #include <cstdint>
@@ -90,8 +91,10 @@ class light_selection {
     // One emitter: every choice is P = 1 where it faces the point.
     if (tree && !tree->empty() && emitters.size() > (hierarchical ? 1 : linear_limit)) {
       tree_ = tree;
-      if (how == light_choice::bvh)
+      if (how == light_choice::bvh) {
         for (memo_entry& m : memo_) m.node = light_bvh::none;
+        for (cluster_entry& c : clusters_) c.node = light_bvh::none;
+      }
       return;
     }
     if (hierarchical && emitters.size() > 1)
@@ -281,24 +284,37 @@ class light_selection {
     return sum;
   }
 
-  // A cluster's weights and their sum as bvh formed them for its parent's
-  // choice (contribution_estimate), for the choice within it, so that they
-  // are not formed again.
-  struct kept_weights {
+  // A cluster's weights at the point (w[i] for slot first + i) and their
+  // sum, formed once: for its parent's choice (contribution_estimate), the
+  // choice within it (pick), and the density at a sample of one of its
+  // lights or at a direction that meets them (pdf, probability). The last
+  // cluster_memo_size clusters weighed at the point are kept, the oldest
+  // replaced first; the weights are the floats cluster_weights gives, so
+  // every P(k) is formed alike whichever call weighed the cluster first.
+  struct cluster_entry {
+    std::uint32_t node;
+    float sum;
     std::array<float, cluster_size> w;
-    float sum = 0.0f;
-    bool valid = false;
   };
+  static constexpr std::size_t cluster_memo_size = 4;
+  const cluster_entry& weights_of(const node& nd, std::uint32_t index) const {
+    for (const cluster_entry& c : clusters_)
+      if (c.node == index) return c;
+    cluster_entry& c = clusters_[next_cluster_];
+    next_cluster_ = (next_cluster_ + 1) % cluster_memo_size;
+    c.node = index;
+    c.sum = cluster_weights(nd, c.w);
+    return c;
+  }
 
-  // The weight at the point of node `index` (nd) under the selection's
-  // measure; bvh leaves a cluster's weights in `kept` where it forms them.
-  float node_weight(const node& nd, std::uint32_t index, kept_weights* kept = nullptr) const {
+  // The weight at the point of node `index` (nd) under the selection's measure.
+  float node_weight(const node& nd, std::uint32_t index) const {
     switch (how_) {
       case light_choice::power: return nd.bounds.phi;
       case light_choice::uniform: return static_cast<float>(nd.count);
       case light_choice::pbrt_bvh: return bounds_importance(nd.bounds, o_, n_, true);
       case light_choice::bvh:
-      default: return memoized_estimate(nd, index, kept);
+      default: return memoized_estimate(nd, index);
     }
   }
 
@@ -307,12 +323,11 @@ class light_selection {
   // otherwise form the same estimates again, and pdf() those pick() formed.
   // The memo returns the float the estimate gave, so every P(k) is formed
   // alike whichever call formed it first.
-  float memoized_estimate(const node& nd, std::uint32_t index, kept_weights* kept = nullptr) const {
+  float memoized_estimate(const node& nd, std::uint32_t index) const {
     memo_entry& m = memo_[index & (memo_size - 1)];
-    // Where a cluster's own weights are wanted (kept), they are formed again.
-    if (!kept && m.node == index) return m.w;
+    if (m.node == index) return m.w;
     // (The estimate may fill m with a node below this one meanwhile.)
-    const float w = contribution_estimate(nd, index, kept);
+    const float w = contribution_estimate(nd, index);
     m.node = index;
     m.w = w;
     return w;
@@ -360,7 +375,7 @@ class light_selection {
   // and 1-57 times the small lights'. The noise-free variance of the
   // choice (bench/light_select_variance.cpp) fell from 0.34 to 0.036 there,
   // and 1.5 to 0.29 under 14 994 small lights (docs/light-selection.md).
-  float contribution_estimate(const node& nd, std::uint32_t index, kept_weights* kept = nullptr) const {
+  float contribution_estimate(const node& nd, std::uint32_t index) const {
     const float bound = bounds_importance(nd.bounds, o_, n_, both_sides_);
     if (!(bound > 0.0f)) return 0.0f;
     const light_bvh::proxy& q = tree_->proxies()[index];
@@ -369,15 +384,7 @@ class light_selection {
     const bool recurse = nd.count <= recurse_limit;
     const bool far = q.planar && d2 > (recurse ? recurse_far : 1.0f) * q.r2;
     static_assert(cluster_size <= recurse_limit, "a cluster is weighed as a point light beyond 2 r only");
-    if (nd.count <= cluster_size && !far) {
-      if (kept) {
-        kept->sum = cluster_weights(nd, kept->w);
-        kept->valid = true;
-        return kept->sum;
-      }
-      std::array<float, cluster_size> w;
-      return cluster_weights(nd, w);
-    }
+    if (nd.count <= cluster_size && !far) return weights_of(nd, index).sum;
     if (!q.planar) return bound;
     float estimate = 0.0f;
     if (far) {
@@ -397,11 +404,10 @@ class light_selection {
   }
 
   // The probabilities of an inner node's two children.
-  void child_probabilities(const node& nd, std::uint32_t index, float& p1, float& p2,
-                           kept_weights* kept1 = nullptr, kept_weights* kept2 = nullptr) const {
+  void child_probabilities(const node& nd, std::uint32_t index, float& p1, float& p2) const {
     const std::vector<node>& nodes = tree_->nodes();
-    const float w1 = node_weight(nodes[index + 1], index + 1, kept1);
-    const float w2 = node_weight(nodes[nd.second], nd.second, kept2);
+    const float w1 = node_weight(nodes[index + 1], index + 1);
+    const float w2 = node_weight(nodes[nd.second], nd.second);
     const float total = w1 + w2;
     if (!(total > 0.0f) || !std::isfinite(total)) {
       p1 = p2 = 0.0f;
@@ -429,23 +435,14 @@ class light_selection {
     const std::vector<node>& nodes = tree_->nodes();
     std::uint32_t i = 0;
     float p = 1.0f;
-    // bvh: each child's cluster weights formed for the choice between them
-    // (kept_weights).
-    std::array<kept_weights, 2> kept;
-    const kept_weights* chosen = nullptr;
     for (;;) {
       const node& nd = nodes[i];
       if (is_cluster(nd)) {
-        std::array<float, cluster_size> w;
-        float sum;
-        if (chosen && chosen->valid)
-          w = chosen->w, sum = chosen->sum;
-        else
-          sum = cluster_weights(nd, w);
-        if (!(sum > 0.0f) || !std::isfinite(sum)) return -1;
-        const int c = choose_in(w, nd.count, sum, u);
+        const cluster_entry& m = weights_of(nd, i);
+        if (!(m.sum > 0.0f) || !std::isfinite(m.sum)) return -1;
+        const int c = choose_in(m.w, nd.count, m.sum, u);
         if (c < 0) return -1;
-        prob = p * (w[static_cast<std::size_t>(c)] / sum);
+        prob = p * (m.w[static_cast<std::size_t>(c)] / m.sum);
         return item(nd.first + static_cast<std::uint32_t>(c)).light;
       }
       if (nd.leaf()) {
@@ -455,8 +452,7 @@ class light_selection {
         return item(nd.first).light;
       }
       float p1, p2;
-      kept[0].valid = kept[1].valid = false;
-      child_probabilities(nd, i, p1, p2, &kept[0], &kept[1]);
+      child_probabilities(nd, i, p1, p2);
       if (!(p1 > 0.0f) && !(p2 > 0.0f)) return -1;
       // u is reused below, rescaled to [0, 1) within the branch taken.
       constexpr float one_minus_epsilon = 0x1.fffffep-1f;
@@ -464,12 +460,10 @@ class light_selection {
         u = std::min(u / p1, one_minus_epsilon);
         p *= p1;
         i = i + 1;
-        chosen = &kept[0];
       } else {
         u = std::min((u - p1) / p2, one_minus_epsilon);
         p *= p2;
         i = nd.second;
-        chosen = &kept[1];
       }
     }
   }
@@ -487,12 +481,11 @@ class light_selection {
       const std::uint32_t i = path[d];
       const node& nd = nodes[i];
       if (is_cluster(nd)) {
-        std::array<float, cluster_size> w;
-        const float sum = cluster_weights(nd, w);
-        if (!(sum > 0.0f) || !std::isfinite(sum)) return 0.0f;
+        const cluster_entry& m = weights_of(nd, i);
+        if (!(m.sum > 0.0f) || !std::isfinite(m.sum)) return 0.0f;
         const std::uint32_t c = nodes[leaf].first - nd.first;
-        if (!(w[c] > 0.0f)) return 0.0f;
-        return p * (w[c] / sum);
+        if (!(m.w[c] > 0.0f)) return 0.0f;
+        return p * (m.w[c] / m.sum);
       }
       if (nd.leaf()) return (i == 0 && !(node_weight(nd, i) > 0.0f)) ? 0.0f : p;
       float p1, p2;
@@ -520,7 +513,7 @@ class light_selection {
   };
 
   // Whether the ray meets the box widened for ray tests (ray_box of a
-  // light_bvh node or slot), for t >= 0.
+  // light_bvh node), for t >= 0.
   static bool meets(const aabb& b, const slab_ray& r) {
     float t0 = 0.0f, t1 = infinity;
     for (int a = 0; a < 3; ++a) {
@@ -530,6 +523,41 @@ class light_selection {
       t1 = std::min(t1, tf);
     }
     return t0 <= t1;
+  }
+
+  // The lights of cluster node i whose ray boxes the ray meets, as bits
+  // (bit c: slot first + c), found through the cluster's own subtree: a
+  // node's ray box holds its children's (light_bvh), so a subtree the ray
+  // misses holds no light it meets, and the set is the one a test of every
+  // slot would give. The caller has met node i's box.
+  std::uint32_t met_in_cluster(std::uint32_t i, const slab_ray& ray) const {
+    static_assert(cluster_size <= 32, "a cluster's lights are bits of a 32-bit mask");
+    const std::vector<node>& nodes = tree_->nodes();
+    const std::uint32_t first = nodes[i].first;
+    // Depth-first, a sibling waits on the stack at each level: at most
+    // count - 1 of them in a cluster of count lights.
+    std::array<std::uint32_t, cluster_size> stack;
+    std::size_t top = 0;
+    std::uint32_t met = 0;
+    for (;;) {
+      const node& nd = nodes[i];
+      if (nd.leaf()) {
+        met |= 1u << (nd.first - first);
+      } else {
+        const bool met1 = meets(nodes[i + 1].ray_box, ray), met2 = meets(nodes[nd.second].ray_box, ray);
+        if (met1) {
+          if (met2) stack[top++] = nd.second;
+          i = i + 1;
+          continue;
+        }
+        if (met2) {
+          i = nd.second;
+          continue;
+        }
+      }
+      if (top == 0) return met;
+      i = stack[--top];
+    }
   }
 
   float light_pdf(std::uint32_t slot, const vec3& dir, std::ptrdiff_t known, float known_pdf) const {
@@ -548,31 +576,21 @@ class light_selection {
     std::size_t top = 0;
     if (meets(nodes[0].ray_box, ray)) stack[top++] = {0, 1.0f};
     float sum = 0.0f;
-    // bvh: the first child's cluster weights, formed for its parent's
-    // choice, as in pick_tree (it is the next node taken off the stack).
-    kept_weights kept;
-    std::uint32_t kept_node = light_bvh::none;
     // Every node on the stack has a box the ray meets.
     while (top > 0) {
       const auto [i, p] = stack[--top];
       const node& nd = nodes[i];
       if (is_cluster(nd)) {
-        std::array<float, cluster_size> w;
-        float total = -1.0f;  // formed only if the ray meets one of the cluster's lights
-        for (std::uint32_t c = 0; c < nd.count; ++c) {
-          const std::uint32_t slot = nd.first + c;
-          if (nd.count > 1 && !meets(tree_->slots()[slot].ray_box, ray)) continue;
-          if (total < 0.0f) {
-            if (i == kept_node && kept.valid) {
-              w = kept.w;
-              total = kept.sum;
-            } else {
-              total = cluster_weights(nd, w);
-            }
-            if (!(total > 0.0f) || !std::isfinite(total)) break;
-          }
-          if (!(w[c] > 0.0f)) continue;
-          sum += p * (w[c] / total) * light_pdf(slot, dir, known, known_pdf);
+        const std::uint32_t met = met_in_cluster(i, ray);
+        if (met == 0) continue;
+        // The weights only where the ray meets one of the cluster's lights.
+        const cluster_entry& m = weights_of(nd, i);
+        if (!(m.sum > 0.0f) || !std::isfinite(m.sum)) continue;
+        // The lights met, summed in slot order (as the choice orders them).
+        for (std::uint32_t rest = met; rest != 0; rest &= rest - 1) {
+          const auto c = static_cast<std::uint32_t>(std::countr_zero(rest));
+          if (!(m.w[c] > 0.0f)) continue;
+          sum += p * (m.w[c] / m.sum) * light_pdf(nd.first + c, dir, known, known_pdf);
         }
         continue;
       }
@@ -585,9 +603,7 @@ class light_selection {
       const bool met1 = meets(nodes[i + 1].ray_box, ray), met2 = meets(nodes[nd.second].ray_box, ray);
       if (!met1 && !met2) continue;
       float p1, p2;
-      kept.valid = false;
-      child_probabilities(nd, i, p1, p2, &kept);
-      kept_node = i + 1;
+      child_probabilities(nd, i, p1, p2);
       if (met2 && p2 > 0.0f) stack[top++] = {nd.second, p * p2};
       if (met1 && p1 > 0.0f) stack[top++] = {i + 1, p * p1};
     }
@@ -611,6 +627,10 @@ class light_selection {
   };
   static constexpr std::size_t memo_size = 64;
   mutable std::array<memo_entry, memo_size> memo_;
+  // bvh: the clusters weighed at this point (weights_of; set up by the
+  // constructor for bvh only) and the entry the next one replaces.
+  mutable std::array<cluster_entry, cluster_memo_size> clusters_;
+  mutable std::uint32_t next_cluster_ = 0;
 };
 
 }  // namespace mcrt
