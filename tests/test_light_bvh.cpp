@@ -112,7 +112,8 @@ bool inside(const aabb& inner, const aabb& outer) {
 
 // Every light of positive power in exactly one leaf, a subtree's lights its
 // range of order(), children's boxes inside their parent's and their
-// normals inside its cone, the flux summed, the depth within max_depth;
+// normals inside its cone, their ray boxes inside its ray box, the flux
+// summed, the depth within max_depth;
 // for 1 to 5000 lights, and 3000 lights all in one place.
 TEST(LightBvh, Invariants) {
   for (const int n : {1, 2, 3, 17, 300, 5000}) {
@@ -142,6 +143,10 @@ TEST(LightBvh, Invariants) {
       EXPECT_EQ(b.first, nd.first + a.count);
       EXPECT_EQ(a.count + b.count, nd.count);
       EXPECT_TRUE(inside(a.bounds.box, nd.bounds.box) && inside(b.bounds.box, nd.bounds.box));
+      // The ray boxes nest too (a cluster's lights are found through its
+      // subtree by them), each holding its own box widened.
+      EXPECT_TRUE(inside(a.ray_box, nd.ray_box) && inside(b.ray_box, nd.ray_box)) << "node " << i;
+      EXPECT_TRUE(inside(light_bvh::widened(nd.bounds.box), nd.ray_box)) << "node " << i;
       EXPECT_NEAR(a.bounds.phi + b.bounds.phi, nd.bounds.phi, 1e-5f * nd.bounds.phi);
       // The children's cones inside the parent's (angles, to rounding).
       for (const auto* c : {&a, &b}) {
