@@ -52,7 +52,7 @@ def interleaved(a, s, mcrt, mi, configs, log):
                     img, sec, cpu = mi.render(scenes[what], spp, seed, busy=r)
                     r.update(seconds=sec, cpu_seconds=cpu, cpu_over_wall=cpu / sec, sampler=what,
                              mse=images.mse(img, s["mi_ref"]), ref_noise_mse=s["mi_meta"]["noise_mse"],
-                             command=Mitsuba.call_text(what, spp, seed),
+                             command=Mitsuba.call_text(what, spp, seed, mi.variant),
                              nonfinite=int(np.count_nonzero(~np.isfinite(img))))
                 r["mse_minus_ref_noise"] = r["mse"] - r["ref_noise_mse"]
                 r["efficiency"] = 1 / (r["mse"] * r["seconds"])
@@ -102,5 +102,5 @@ def command_summary(res, commands):
     for smp in res["settings"]["samplers"]:
         lines.append(f"# Mitsuba, {smp}: scene = mi.load_dict(...) of OUT/xml/SCENE.xml with the film and "
                      "sampler below, then timed:")
-        lines.append(Mitsuba.call_text(smp, "SPP", "SEED"))
+        lines.append(Mitsuba.call_text(smp, "SPP", "SEED", res["mitsuba_variant"]))
     return lines

@@ -22,6 +22,8 @@ VARIANT = "scalar_rgb"
 
 class Mitsuba:
     def __init__(self, threads, variant=VARIANT):
+        if variant.startswith("llvm"):  # Debian's libLLVM (apt-get install libllvm19) unless set
+            os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so")
         import drjit as dr
         import mitsuba as mi
         mi.set_variant(variant)
@@ -33,6 +35,7 @@ class Mitsuba:
         self.version = mi.__version__
         self.drjit_version = dr.__version__
         self._scenes = {}
+        self._warm = set()
 
     def load(self, desc, key):
         """mi.load_dict of a translated scene, cached under `key` (not timed)."""
@@ -46,6 +49,13 @@ class Mitsuba:
     def render(self, scene, spp, seed, busy=None):
         """(image HxWx3 float32, wall seconds of mi.render alone, process CPU seconds);
         `busy`, a dict, gets the number of threads busy > 10 % of the wall time."""
+        # LLVM variants compile their kernels at a scene's first render (the
+        # spp and seed are not compiled in: a second spp renders warm): one
+        # untimed render of 1 spp per scene first, so that every timed one is warm.
+        if self.variant.startswith("llvm") and id(scene) not in self._warm:
+            self.dr.eval(self.mi.render(scene, spp=1, seed=seed + 7919))
+            self.dr.sync_thread()
+            self._warm.add(id(scene))
         before = _thread_cpu() if busy is not None else None
         c0, t0 = time.process_time(), time.perf_counter()
         img = self.mi.render(scene, spp=spp, seed=seed)
@@ -63,9 +73,10 @@ class Mitsuba:
         return arr[..., :3], t1 - t0, c1 - c0
 
     @staticmethod
-    def call_text(sampler, spp, seed):
+    def call_text(sampler, spp, seed, variant=VARIANT):
+        warm = ", after one untimed 1-spp render of the scene" if variant.startswith("llvm") else ""
         return (f"mi.render(mi.load_dict(scene with sampler {sampler!r}), spp={spp}, seed={seed})"
-                f"  [variant {VARIANT}]")
+                f"  [variant {variant}{warm}]")
 
 
 def _thread_cpu():

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from . import images, measure, report, translate, validate, writers
 from .mcrt_run import Mcrt, parse_flags
-from .mitsuba_run import VARIANT, Mitsuba
+from .mitsuba_run import Mitsuba
 
 T0 = time.time()
 
@@ -59,7 +59,7 @@ def prepare_scene(a, path, mcrt, mi, ref_flags, commands):
     mc_ref, mc_path, mc_meta, mc_noise = images.reference(a.out, f"{name}-mcrt", mc_fields, a.ref_spp, mcrt_half, log)
     ref_desc = translate.describe(scene, w, h, spp=a.ref_spp // 2, sampler=a.mitsuba_ref_sampler,
                                   max_depth=a.max_depth)
-    mi_fields = {"renderer": "mitsuba", "version": mi.version, "variant": VARIANT, "scene": scene,
+    mi_fields = {"renderer": "mitsuba", "version": mi.version, "variant": mi.variant, "scene": scene,
                  "xml": writers.to_xml(ref_desc), "spp": a.ref_spp, "seeds": images.REF_SEEDS}
     ref_scene = mi.load(ref_desc, (name, "ref"))
     mi_ref, mi_path, mi_meta, mi_noise = images.reference(
@@ -111,13 +111,13 @@ def main(a, argv):
         print("\n".join(str(a.out / "xml" / f"{Path(p).stem}.xml") for p in a.scenes))
         return
     mcrt = Mcrt(private_copy(a.mcrt, a.out), a.threads, lambda purpose, cmd: commands.append((purpose, cmd)))
-    mi = Mitsuba(a.threads)
+    mi = Mitsuba(a.threads, a.variant)
     measure.probe(mcrt, a.scenes[0], configs + [("reference", ref_flags, a.mcrt_ref_args)], a.out, log)
     res = {"bench_command": shlex.join(["python", "-m", "bench.mitsuba", *argv]), "machine": machine(),
            "mcrt": {"binary": str(mcrt.binary), "copied_from": str(a.mcrt), "sha256": mcrt.sha256,
                     "threads": a.threads,
                     "configs": {n: f for n, _, f in configs}, "reference_flags": a.mcrt_ref_args},
-           "mitsuba_version": mi.version, "drjit_version": mi.drjit_version, "mitsuba_variant": VARIANT,
+           "mitsuba_version": mi.version, "drjit_version": mi.drjit_version, "mitsuba_variant": mi.variant,
            "mitsuba_threads": mi.threads, "image_reader": images.READER,
            "settings": {"size": a.size, "spp": a.spp, "seeds": a.seeds, "ref_spp": a.ref_spp,
                         "samplers": a.samplers, "max_depth": a.max_depth,
