@@ -70,7 +70,7 @@ def parse(argv):
                    help="named metals: Mitsuba's presets (default) or pbrt-v4's tables as mcrt converts them")
     g.add_argument("--variant", default="scalar_rgb",
                    help="Mitsuba variant, here and for the Cornell scenes (default %(default)s; "
-                        "llvm_ad_rgb, its fastest on a CPU, renders each scene once untimed first)")
+                        "llvm_ad_rgb is its fastest on a CPU)")
     g.add_argument("--reference", help="an EXR whose mean both images are compared with (e.g. TungstenRender.exr)")
     g.add_argument("--png-width", type=int, default=256, help="width of each of the PNG's three panels")
     t = p.add_argument_group("throughput on a >= 1M-triangle mesh against Mitsuba's llvm_ad_rgb (see README.md)")

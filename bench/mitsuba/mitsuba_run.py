@@ -35,7 +35,6 @@ class Mitsuba:
         self.version = mi.__version__
         self.drjit_version = dr.__version__
         self._scenes = {}
-        self._warm = set()
 
     def load(self, desc, key):
         """mi.load_dict of a translated scene, cached under `key` (not timed)."""
@@ -49,13 +48,6 @@ class Mitsuba:
     def render(self, scene, spp, seed, busy=None):
         """(image HxWx3 float32, wall seconds of mi.render alone, process CPU seconds);
         `busy`, a dict, gets the number of threads busy > 10 % of the wall time."""
-        # LLVM variants compile their kernels at a scene's first render (the
-        # spp and seed are not compiled in: a second spp renders warm): one
-        # untimed render of 1 spp per scene first, so that every timed one is warm.
-        if self.variant.startswith("llvm") and id(scene) not in self._warm:
-            self.dr.eval(self.mi.render(scene, spp=1, seed=seed + 7919))
-            self.dr.sync_thread()
-            self._warm.add(id(scene))
         before = _thread_cpu() if busy is not None else None
         c0, t0 = time.process_time(), time.perf_counter()
         img = self.mi.render(scene, spp=spp, seed=seed)
@@ -74,9 +66,8 @@ class Mitsuba:
 
     @staticmethod
     def call_text(sampler, spp, seed, variant=VARIANT):
-        warm = ", after one untimed 1-spp render of the scene" if variant.startswith("llvm") else ""
         return (f"mi.render(mi.load_dict(scene with sampler {sampler!r}), spp={spp}, seed={seed})"
-                f"  [variant {variant}{warm}]")
+                f"  [variant {variant}]")
 
 
 def _thread_cpu():
