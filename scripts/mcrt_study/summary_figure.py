@@ -31,7 +31,7 @@ import sys
 from pathlib import Path
 
 from .analysis import analyse_configs, family_crossovers
-from .config import CSV_COLUMNS, REPO_ROOT, STRATEGY_STYLE, SceneInfo, build_parser, resolve_settings
+from .config import CSV_COLUMNS, PRE_SELECT_CSV_COLUMNS, REPO_ROOT, STRATEGY_STYLE, SceneInfo, build_parser, resolve_settings
 from .results import parse_row
 
 RESULTS = REPO_ROOT / "bench" / "results"
@@ -48,10 +48,12 @@ MODE_DEPTH_DIRECT = 1
 
 
 def read_rows(csv_path: Path) -> list[dict]:
-    """The rows of a committed results.csv of the current format (never rewritten here)."""
+    """The rows of a committed results.csv of the current format, or of the one before the
+    light_select column (its rows: the default selection, as parse_row reads them; the file is
+    never rewritten here)."""
     with csv_path.open(newline="", encoding="utf-8") as f:
         reader = csv.DictReader(f)
-        if reader.fieldnames != CSV_COLUMNS:
+        if reader.fieldnames not in (CSV_COLUMNS, PRE_SELECT_CSV_COLUMNS):
             raise SystemExit(f"summary_figure: {csv_path}: not the study's current CSV format")
         return [parse_row(r) for r in reader]
 
@@ -110,7 +112,8 @@ def mitsuba_ratios(path: Path) -> dict:
     """Per scene and mcrt configuration: the geometric mean over spp of the efficiency over
     Mitsuba's independent sampler and over its best low-discrepancy one; and the validation."""
     data = json.loads(path.read_text(encoding="utf-8"))
-    out: dict = {"ratios": {}, "best_ld": data["best_ld_sampler"], "validation": {}}
+    out: dict = {"ratios": {}, "best_ld": data["best_ld_sampler"], "validation": {},
+                 "variant": data.get("mitsuba_variant", "scalar_rgb")}
     for row in data["table"]:
         if row["renderer"] != "mcrt":
             continue
@@ -255,16 +258,19 @@ def draw(s: dict, png: Path) -> None:
         ax.plot(xs, indep, "v", ms=7, color=scene_colors[k], mec="k", mew=0.6, ls="none")
         for x, v in zip(xs, indep):
             ax.annotate(f"{v:.1f}", (x, v), xytext=(0, 5), textcoords="offset points", ha="center", fontsize=7)
+        for x, v in zip(xs, best):
+            ax.annotate(f"{v:.2f}", (x, v), xytext=(0, -10), textcoords="offset points", ha="center", fontsize=6)
     ax.axhline(1.0, color="k", lw=0.9)
     ax.set_yscale("log")
-    ax.set_ylim(0.8, 150)
-    ax.yaxis.set_major_locator(ticker.FixedLocator([1, 2, 5, 10, 20, 50]))
+    ax.set_ylim(0.2, 40)
+    ax.yaxis.set_major_locator(ticker.FixedLocator([0.25, 0.5, 1, 2, 5, 10, 20]))
     ax.yaxis.set_major_formatter(plain)
     ax.yaxis.set_minor_formatter(ticker.NullFormatter())
     ax.set_xticks(range(len(configs)))
     ax.set_xticklabels(config_labels, fontsize=8)
     ax.set_ylabel("mcrt efficiency / Mitsuba 3's")
-    ax.set_title("(c) mcrt against Mitsuba 3's path tracer (scalar_rgb)\nefficiency ratio, geometric mean over spp", fontsize=10)
+    ax.set_title(f"(c) mcrt against Mitsuba 3's path tracer ({m['variant']})\n"
+                 "efficiency ratio, geometric mean over spp", fontsize=10)
     ax.grid(True, axis="y", alpha=0.3)
     from matplotlib.patches import Patch
     handles = [Patch(color=c, alpha=0.85, label=sc) for sc, c in zip(scenes, scene_colors)]
