@@ -31,7 +31,8 @@ import sys
 from pathlib import Path
 
 from .analysis import analyse_configs, family_crossovers
-from .config import CSV_COLUMNS, PRE_SELECT_CSV_COLUMNS, REPO_ROOT, STRATEGY_STYLE, SceneInfo, build_parser, resolve_settings
+from .config import (CSV_COLUMNS, PRE_SELECT_CSV_COLUMNS, REPO_ROOT, STRATEGY_STYLE, SceneInfo, build_parser,
+                     resolve_settings)
 from .results import parse_row
 
 RESULTS = REPO_ROOT / "bench" / "results"
@@ -54,7 +55,8 @@ def read_rows(csv_path: Path) -> list[dict]:
     with csv_path.open(newline="", encoding="utf-8") as f:
         reader = csv.DictReader(f)
         if reader.fieldnames not in (CSV_COLUMNS, PRE_SELECT_CSV_COLUMNS):
-            raise SystemExit(f"summary_figure: {csv_path}: not the study's current CSV format")
+            raise SystemExit(f"summary_figure: {csv_path}: not the study's current CSV format, "
+                             "nor the one before light_select")
         return [parse_row(r) for r in reader]
 
 
