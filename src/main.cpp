@@ -227,6 +227,7 @@ int run_render(const render_options& opt) {
                           {"image_variance", a.image_variance},
                           {"rest_cost", a.rest_cost},
                           {"rest_noise", a.rest_noise},
+                          {"rest_weight", a.rest_weight},
                           {"fixed_point_steps", a.fixed_point_steps},
                           {"cheapest", a.cheapest},
                           {"gain_factor_seconds", a.kappa_seconds},

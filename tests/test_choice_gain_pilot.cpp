@@ -283,7 +283,9 @@ struct settle_floor {
 // the measured and the modelled share; R, with mis, the low-variance
 // pilot's reflected noise plus the pilot's emission term, at least V b (b >= 0 the BSDF samples' part), the same
 // pilot run apart (low_variance_pilot, which leaves the scene's lights as
-// they were); V_l at the fixed point R + s' V, so R <= V_l <= R + s V (s'
+// they were), weighed with Sobol points by kappa_R / kappa_l (kappa_l
+// measured at the choice, below kappa_R on this floor); V_l at the fixed
+// point R + s' V, so R <= V_l <= R + s V (s'
 // <= s: the choice never adds to the light's modelled noise), and a fixed
 // point indeed (settle_fixed_point from it takes no step); c_rest is
 // modelled from the pilot's counts (render/rest_cost.hpp), or left as
@@ -322,12 +324,24 @@ TEST(ChoiceGainPilot, SettleWeighsEachAutoLight) {
         << to_string(kind);
     EXPECT_GE(a[0].rest_noise, floor);
     EXPECT_GT(a[0].rest_pilot_seconds, 0.0);
-    EXPECT_GE(a[0].image_variance, a[0].rest_noise * (1.0 - 1e-6));
-    EXPECT_LE(a[0].image_variance, (a[0].rest_noise + a[0].noise_share * v) * (1.0 + 1e-6));
+    // With Sobol points R weighed by kappa_R / kappa_l, kappa_l measured
+    // at the choice (the light's gain, which the points leave less of).
+    const double rest = a[0].weighed_rest_noise(floor, low.image_variance + noise.edge_variance);
+    if (kind == sampler_kind::independent) {
+      EXPECT_EQ(a[0].rest_weight, 1.0);
+      EXPECT_NEAR(rest, a[0].rest_noise, 1e-6 * v);
+    } else {
+      EXPECT_GT(a[0].kappa_seconds, 0.0) << "kappa_l measured";
+      EXPECT_LT(a[0].kappa, rest_sequence_factor(rs));
+      EXPECT_NEAR(a[0].rest_weight, rest_sequence_factor(rs) / a[0].kappa, 1e-9 * a[0].rest_weight);
+      EXPECT_GE(rest, a[0].rest_noise - 1e-6 * v);
+    }
+    EXPECT_GE(a[0].image_variance, rest * (1.0 - 1e-6));
+    EXPECT_LE(a[0].image_variance, (rest + a[0].noise_share * v) * (1.0 + 1e-6));
     EXPECT_GT(a[0].fixed_point_steps, 0) << to_string(kind) << ": the choice pays here, and moves V_l";
     // From the fixed point, no step.
     auto_params q = s.params;
-    EXPECT_EQ(settle_fixed_point(at_v, noise.receivers, models, v, a[0].noise_share, a[0].rest_noise, modelled, q), 0);
+    EXPECT_EQ(settle_fixed_point(at_v, noise.receivers, models, v, a[0].noise_share, rest, modelled, q), 0);
     scene fixed = f.with_auto(p);
     EXPECT_GE(settle_auto_lights(fixed, f.cam, rs, noise, 64, false)[0].rest_cost, p.rest_cost);
   }

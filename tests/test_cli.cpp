@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -437,27 +439,38 @@ TEST_F(Cli, AutoTakesTheCheapestStrategyWhereItsChoiceDoesNotPay) {
 // never from how long a run took (render/rest_cost.hpp): the same command
 // gives the same image and the same settlement of its light (c_rest, kappa,
 // V_l) for any thread count and on every run, here where kappa is measured
-// (nee; a large lamp low over the floor, Sobol samples).
+// (nee, and mis with R's weight; a large lamp low over the floor, Sobol
+// samples; the image with one choice per pixel at the first surface).
 TEST_F(Cli, AutoIsReproducible) {
   const std::string floor = R"({"type": "xz_rect", "x0": -5, "x1": 5, "z0": -5, "z1": 5, "k": 0, "material": "white"})";
   const std::string lamp = R"({"type": "xz_rect", "x0": -1.5, "x1": 1.5, "z0": -1.5, "z1": 1.5, "k": 0.3, "material": "light", "flip": true})";
   const fs::path s = write("lamp.json", scene_with(floor + ", " + lamp + R"(, {"type": "sphere", "center": [0.3, 0.1, -0.2], "radius": 0.1, "material": "white"})"));
-  std::vector<nlohmann::json> lights;
-  for (const char* threads : {"1", "2", "2"}) {
-    const fs::path out = dir / (std::string("o") + std::to_string(lights.size()) + ".exr"), stats = dir / "s.json";
-    ASSERT_EQ(run("render " + s.string() + " -o " + out.string() + " --width 64 --height 48 --spp 8 --seed 2 --max-depth 1 "
-                  "--integrator nee --light-sampling auto --quiet --threads " + threads + " --stats " + stats.string()).status, 0);
-    const auto j = nlohmann::json::parse(slurp(stats));
-    ASSERT_EQ(j["auto_lights"].size(), 1u);
-    lights.push_back(j["auto_lights"][0]);
-    EXPECT_GT(lights.back()["gain_factor_seconds"].get<double>(), 0.0) << "kappa measured (nee)";
-    lights.back().erase("gain_factor_seconds");  // a time: the one part that may differ
-    EXPECT_LT(lights.back()["gain_factor"].get<double>(), 1.0) << "kappa measured (nee)";
-    if (lights.size() > 1) {
-      EXPECT_EQ(lights.back(), lights.front()) << threads;
-      const result r = run("diff " + out.string() + " " + (dir / "o0.exr").string() + " --json");
-      ASSERT_EQ(r.status, 0) << r.err;
-      EXPECT_EQ(nlohmann::json::parse(r.out)["mse"].get<double>(), 0.0) << threads;
+  // With mis kappa_l is measured too (Sobol samples), and R weighed by it.
+  for (const std::string integrator : {"nee", "mis"}) {
+    std::vector<nlohmann::json> lights;
+    for (const char* threads : {"1", "2", "2"}) {
+      const fs::path out = dir / (integrator + std::to_string(lights.size()) + ".exr"), stats = dir / "s.json";
+      ASSERT_EQ(run("render " + s.string() + " -o " + out.string() + " --width 64 --height 48 --spp 8 --seed 2 --max-depth 1 "
+                    "--integrator " + integrator + " --light-sampling auto --quiet --threads " + threads + " --stats " +
+                    stats.string()).status, 0);
+      const auto j = nlohmann::json::parse(slurp(stats));
+      ASSERT_EQ(j["auto_lights"].size(), 1u);
+      lights.push_back(j["auto_lights"][0]);
+      EXPECT_GT(lights.back()["gain_factor_seconds"].get<double>(), 0.0) << "kappa measured " << integrator;
+      // Times: the parts that may differ.
+      lights.back().erase("gain_factor_seconds");
+      lights.back().erase("rest_pilot_seconds");
+      EXPECT_LT(lights.back()["gain_factor"].get<double>(), 1.0) << "kappa measured " << integrator;
+      // R's weight kappa_R / kappa_l where kappa_l < kappa_R = 1/sqrt(8), else 1.
+      if (integrator == "mis")
+        EXPECT_NEAR(lights.back()["rest_weight"].get<double>(),
+                    std::max(1.0, 1.0 / std::sqrt(8.0) / lights.back()["gain_factor"].get<double>()), 1e-9);
+      if (lights.size() > 1) {
+        EXPECT_EQ(lights.back(), lights.front()) << integrator << " " << threads;
+        const result r = run("diff " + out.string() + " " + (dir / (integrator + "0.exr")).string() + " --json");
+        ASSERT_EQ(r.status, 0) << r.err;
+        EXPECT_EQ(nlohmann::json::parse(r.out)["mse"].get<double>(), 0.0) << integrator << " " << threads;
+      }
     }
   }
 }

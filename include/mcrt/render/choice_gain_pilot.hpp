@@ -54,13 +54,20 @@
 // distance_h0.3).
 //
 // The image's own samples (stratified, Sobol) leave less of a light's noise
-// than independent ones (the factor kappa, 0.01-0.2 with direct light),
-// and of the rest of its noise alike: R and the light's part are both
-// reduced, and the factor cancels from the scores (the earlier form, R left
-// at its independent size with kappa measured, weighed the choice against
-// 5x the image's noise under a sliver of aspect 10, 0.15x solid angle's
-// efficiency). Where the rest is not reduced alike (deep bounces of global
-// light), the choice is weighed against less noise than the image has.
+// than independent ones, and less of the rest, but not alike: under a small
+// light 3 or 10 edges above a floor (tri_distance_h3, h10) Sobol points
+// leave 0.004-0.05 of the light's noise and 0.3-0.5 of the rest
+// (bench/results/sobol_noise_split). The score weighs a light's noise
+// against the image's; with kappa_l and kappa_R what the sequence leaves of
+// each, V_l = R kappa_R / kappa_l + s' V in the light's units. So with
+// those samples, kappa_l is measured at the fixed point's choice (as nee's
+// kappa below, choice_gain_factor), kappa_R is modelled
+// (rest_sequence_factor), and where kappa_l < kappa_R the fixed point is
+// taken again with R weighed by kappa_R / kappa_l (the floor V b not: it
+// is the light's own estimate's noise). Taking the two as cancelling (the
+// earlier form) took projected solid angle over most of the floor under
+// those lights, where area sampling or solid angle is best (0.67x and
+// 0.88x the best fixed strategy).
 //
 // With nee there is no BSDF floor: a light's samples are all of its
 // estimate, s clamped to 1 leaves R = 0, and the fixed point took
@@ -140,6 +147,20 @@ double choice_gain_factor(const Scene& sc, const camera& cam, const render_setti
   });
 }
 
+// kappa_R (header): what the image's samples leave of the rest of its
+// noise, against independent samples; 1 for independent samples, else
+// 1/sqrt(spp) and at least 1/3. Not measured: the rest sits in few pixels
+// (the edges of what is in view), and measured in the pilot it spread
+// 0.005-0.5 between seeds where it is 0.27. A discontinuity across a
+// pixel leaves N^-3/2 of its variance to N stratified samples against N^-1
+// (1/sqrt(N) of it; Owen 1997); Sobol points left 0.27-0.50 of the rest
+// of the triangle members at 8 and 32 spp
+// (bench/results/sobol_noise_split), about as much at both.
+inline double rest_sequence_factor(const render_settings& rs) {
+  if (rs.sampler == sampler_kind::independent) return 1.0;
+  return std::max(1.0 / 3.0, 1.0 / std::sqrt(double(std::max(rs.spp, 1))));
+}
+
 // The fixed point of a light's V_l and c_rest (header), from V, its noise
 // share s, R and c_rest; p holds V_l and c_rest on entry (V and c_rest)
 // and the fixed point on return; the steps taken (at most `steps`).
@@ -206,6 +227,11 @@ struct auto_light_settlement {
   double noise_share = 0.0;     // s: the light's own noise with its cheapest strategy, over V
   double noise_share_measured = 0.0, noise_share_model = 0.0;
   double rest_noise = 0.0;      // R: the image's noise beyond the light's (header)
+  double rest_weight = 1.0;     // mis, mixture: kappa_R / kappa_l, R's weight in V_l (header; 1: not weighed)
+  // R as V_l takes it: the rest beyond the BSDF floor `floor` weighed, at
+  // least the floor (the light's own noise, which the sequence reduces as
+  // the light's).
+  double weighed_rest_noise(double floor, double rest) const { return std::max(rest * rest_weight, floor); }
   double rest_pilot_seconds = 0.0;  // the low-variance pilot's time, on the light that ran it (mis, mixture: header)
   double image_variance = 0.0;  // V_l: the V its rule sees
   double rest_cost = 0.0;       // c_rest its rule took, ns per light sample (with its choice's own cost: header)
@@ -318,8 +344,37 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
             a.rest_pilot_seconds = low_seconds;
             low_seconds = 0.0;
             a.rest_noise = std::max(low->image_variance + noise.edge_variance, v * s.mis_floor(models));
+            const auto_params start = p;
             a.fixed_point_steps = settle_fixed_point(s, noise.receivers, models, v, a.noise_share, a.rest_noise,
                                                      a.rest_cost, p);
+            // With stratified or Sobol samples: kappa_l at that fixed
+            // point's choice, and the fixed point again with R weighed by
+            // kappa_R / kappa_l where the sequence leaves less of the
+            // light's noise than of the rest (header).
+            if (rs.sampler != sampler_kind::independent) {
+              const S settled = s.with_params(p);
+              std::vector<edge_pixel> dearer;
+              for (std::size_t k = 0; k < noise.receivers.size(); ++k)
+                if (settled.choice(noise.receivers[k].p, noise.receivers[k].n) != s.cheapest())
+                  dearer.push_back(noise.receiver_pixels[k]);
+              if (!dearer.empty()) {
+                const auto kappa_start = std::chrono::steady_clock::now();
+                a.kappa_first_bounce = choice_gain_factor(sc, cam, rs, settled, evenly_spaced(dearer, pixels));
+                a.kappa_seconds =
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - kappa_start).count();
+                const double f = std::clamp(noise.first_bounce_share, 0.0, 1.0);
+                a.kappa = f * a.kappa_first_bounce + (1.0 - f);
+                const double kappa_rest = rest_sequence_factor(rs);
+                if (a.kappa > 0.0 && a.kappa < kappa_rest) {
+                  a.rest_weight = kappa_rest / a.kappa;
+                  p = start;
+                  const double weighed = a.weighed_rest_noise(v * s.mis_floor(models),
+                                                              low->image_variance + noise.edge_variance);
+                  a.fixed_point_steps =
+                      settle_fixed_point(s, noise.receivers, models, v, a.noise_share, weighed, a.rest_cost, p);
+                }
+              }
+            }
             a.image_variance = p.image_variance;
             a.rest_cost = p.rest_cost;
             rebuilt = s.with_params(p);

@@ -151,6 +151,29 @@ inline float pdf(const light& l, const vec3& o, const vec3& n, const vec3& dir) 
 }
 
 // Surface area of a light's shape (the whole sphere for a sphere).
+// The same at a camera ray's first surface, where the lights `auto`
+// samples take one choice over the pixel's footprint fp (nullptr: none;
+// sampling/auto_footprint.hpp); every other light as above.
+inline bool sample(const light& l, const vec3& o, const vec3& n, vec2 u, light_sample& out,
+                   const auto_footprint* fp) {
+  if (!fp) return sample(l, o, n, u, out);
+  return dispatch(l, [&]<class S>(const S& s) {
+    if constexpr (strategy_of<S>() == light_sampling::automatic)
+      return s.sample(o, n, u, out, fp);
+    else
+      return mcrt::sample(s, o, n, u, out);
+  });
+}
+inline float pdf(const light& l, const vec3& o, const vec3& n, const vec3& dir, const auto_footprint* fp) {
+  if (!fp) return pdf(l, o, n, dir);
+  return dispatch(l, [&]<class S>(const S& s) {
+    if constexpr (strategy_of<S>() == light_sampling::automatic)
+      return s.pdf(o, n, dir, fp);
+    else
+      return mcrt::pdf(s, o, n, dir);
+  });
+}
+
 inline float surface_area(const rect& r) { return r.area; }
 inline float surface_area(const ellipse& e) { return e.area; }
 inline float surface_area(const sphere& s) { return 2.0f * two_pi * s.radius * s.radius; }

@@ -131,6 +131,11 @@ class light_selection {
 
   const vec3& point() const { return o_; }
   const vec3& normal() const { return n_; }
+  // The pixel's footprint at a camera ray's first surface (nullptr
+  // elsewhere): the lights `auto` samples take one choice over it in
+  // sample() and pdf() alike (sampling/auto_footprint.hpp).
+  const auto_footprint* footprint() const { return footprint_; }
+  void set_footprint(const auto_footprint* fp) { footprint_ = fp; }
 
   // Picks an emitter with u in [0, 1): its index in the scene's lights, or
   // -1 when there is none; prob is P(k).
@@ -199,14 +204,15 @@ class light_selection {
     if (count_ == 0) return 0.0f;
     if (count_ == 1 && emitters_.size() == 1) {  // P = 1, as pick
       const std::size_t k = emitters_[0].light;
-      return static_cast<std::ptrdiff_t>(k) == known ? known_pdf : mcrt::pdf(lights_[k], o_, n_, dir);
+      return static_cast<std::ptrdiff_t>(k) == known ? known_pdf : mcrt::pdf(lights_[k], o_, n_, dir, footprint_);
     }
     float sum = 0.0f;
     for (std::size_t i = 0; i < emitters_.size(); ++i) {
       const emitter& e = emitters_[i];
       const float p = probability_of(i);
       if (!(p > 0.0f)) continue;
-      sum += p * (static_cast<std::ptrdiff_t>(e.light) == known ? known_pdf : mcrt::pdf(lights_[e.light], o_, n_, dir));
+      sum += p * (static_cast<std::ptrdiff_t>(e.light) == known ? known_pdf
+                                                                 : mcrt::pdf(lights_[e.light], o_, n_, dir, footprint_));
     }
     return sum;
   }
@@ -562,7 +568,7 @@ class light_selection {
 
   float light_pdf(std::uint32_t slot, const vec3& dir, std::ptrdiff_t known, float known_pdf) const {
     const std::uint32_t k = item(slot).light;
-    return static_cast<std::ptrdiff_t>(k) == known ? known_pdf : mcrt::pdf(lights_[k], o_, n_, dir);
+    return static_cast<std::ptrdiff_t>(k) == known ? known_pdf : mcrt::pdf(lights_[k], o_, n_, dir, footprint_);
   }
 
   float pdf_tree(const vec3& dir, std::ptrdiff_t known, float known_pdf) const {
@@ -614,6 +620,7 @@ class light_selection {
   std::span<const emitter> emitters_;
   const light_bvh* tree_ = nullptr;
   vec3 o_{0.0f}, n_{0.0f, 0.0f, 1.0f};
+  const auto_footprint* footprint_ = nullptr;
   light_choice how_ = light_choice::power;
   bool both_sides_ = false;
   std::size_t count_ = 0;

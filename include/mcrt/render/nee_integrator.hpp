@@ -52,7 +52,8 @@ color sample_direct_light(const Scene& sc, const vec3& p, const vec3& n, const c
   const std::ptrdiff_t k = sel.pick(sel.needs_choice() ? ps.get1d(b + layout::light_choice) : 0.0f, prob);
   if (k < 0) return color(0.0f);
   light_sample s;
-  if (!sample(sc.lights[static_cast<std::size_t>(k)], p, n, ps.get2d(b + layout::light), s)) return color(0.0f);
+  if (!sample(sc.lights[static_cast<std::size_t>(k)], p, n, ps.get2d(b + layout::light), s, sel.footprint()))
+    return color(0.0f);
   const float cos_theta = glm::dot(s.dir, n);
   if (!(cos_theta > 0.0f)) return color(0.0f);
   const float p_light = sel.pdf(s.dir, k, s.pdf);
@@ -77,7 +78,8 @@ color sample_direct_light_bsdf(const Scene& sc, const hit_record& rec, const sha
   const std::ptrdiff_t k = sel.pick(sel.needs_choice() ? ps.get1d(b + layout::light_choice) : 0.0f, prob);
   if (k < 0) return color(0.0f);
   light_sample s;
-  if (!sample(sc.lights[static_cast<std::size_t>(k)], sel.point(), sel.normal(), ps.get2d(b + layout::light), s))
+  if (!sample(sc.lights[static_cast<std::size_t>(k)], sel.point(), sel.normal(), ps.get2d(b + layout::light), s,
+              sel.footprint()))
     return color(0.0f);
   const vec3 wi = fr.to_local(s.dir);
   const color f = bsdf.eval(wo, wi) * std::abs(wi.z);
@@ -110,14 +112,21 @@ struct next_event_integrator {
     const light_selection& select_lights(const Scene& sc, const vec3& o, const vec3& n, light_choice how,
                                          bool both_sides = false) {
       static_assert(std::is_trivially_destructible_v<light_selection>);
-      return *std::construct_at(&prev_sel, sc, o, n, how, both_sides);
+      light_selection& sel = *std::construct_at(&prev_sel, sc, o, n, how, both_sides);
+      sel.set_footprint(footprint);
+      return sel;
     }
+    // The pixel's footprint while the path is at its camera ray's first
+    // surface (renderer.hpp), then nullptr.
+    const auto_footprint* footprint = nullptr;
   };
 
   template <class Scene, class P>
-  static color li(const Scene& sc, ray r, P& ps, const path_settings& set) {
+  static color li(const Scene& sc, ray r, P& ps, const path_settings& set, const auto_footprint* fp = nullptr) {
     path_state st;
+    st.footprint = fp;
     for (int depth = 0;; ++depth) {
+      if (depth == 1) st.footprint = nullptr;
       hit_record rec;
       if (!sc.hit(r, 0.0f, infinity, rec)) {
         st.radiance += st.throughput * sc.background;

@@ -5,6 +5,10 @@
 // choice depends on (light, o, n) only, so sample(), the pdf returned with
 // a sample, pdf() and the true density agree as they do for the chosen
 // strategy: the auto strategy's density at o is exactly that strategy's.
+// At a camera ray's first surface the renderer passes the pixel's
+// footprint, and the choice is the dearest over it on o's plane
+// (auto_footprint.hpp): a function of (light, o, n, pixel), fixed along a
+// path, with the same agreement.
 //
 // The rule. A light sample's share of a pixel's error is modelled as
 // (cost_s + c_rest) (v_s + v_rest): cost_s the strategy's own time per
@@ -75,6 +79,7 @@
 #include "mcrt/geometry/sphere.hpp"
 #include "mcrt/geometry/triangle_mesh.hpp"
 #include "mcrt/sampling/ellipse_area.hpp"
+#include "mcrt/sampling/auto_footprint.hpp"
 #include "mcrt/sampling/auto_table.hpp"
 #include "mcrt/sampling/light_sample.hpp"
 #include "mcrt/sampling/projected_rectangle.hpp"
@@ -1285,6 +1290,17 @@ struct auto_sampler {
   bool faces(const vec3& o) const { return area.faces(o); }
 
   light_sampling choice(const vec3& o, const vec3& n) const { return rule_.choose(o, n); }
+  // At a camera ray's first surface: the dearest choice over the pixel's
+  // footprint on the plane of (o, n), where fp has points on it
+  // (auto_footprint.hpp); the per-point choice elsewhere.
+  light_sampling choice(const vec3& o, const vec3& n, const auto_footprint* fp) const {
+    if (fp) {
+      const int plane = fp->plane_of(o, n);
+      if (plane >= 0)
+        return fp->dearest(this, plane, [&](const vec3& q, const vec3& m) { return rule_.choose(q, m); });
+    }
+    return rule_.choose(o, n);
+  }
 
   // Whether the choice pays for itself at the receivers rs (the surfaces an
   // image's pixels see, from its noise pilot): the mean over them of the
@@ -1395,8 +1411,11 @@ struct auto_sampler {
     return cheapest() == light_sampling::area ? area.sample(o, u, s) : solid_angle.sample(o, u, s);
   }
 
-  bool sample(const vec3& o, const vec3& n, vec2 u, light_sample& s) const {
-    switch (choice(o, n)) {
+  bool sample(const vec3& o, const vec3& n, vec2 u, light_sample& s) const { return sample(o, n, u, s, nullptr); }
+  float pdf(const vec3& o, const vec3& n, const vec3& dir) const { return pdf(o, n, dir, nullptr); }
+  // The same with the choice over a pixel's footprint fp (choice above).
+  bool sample(const vec3& o, const vec3& n, vec2 u, light_sample& s, const auto_footprint* fp) const {
+    switch (choice(o, n, fp)) {
       case light_sampling::area: return area.sample(o, u, s);
       case light_sampling::solid_angle: return solid_angle.sample(o, u, s);
       default: return projected.sample(o, n, u, s);
@@ -1405,10 +1424,10 @@ struct auto_sampler {
   // A direction whose area density is 0 misses the light (or o is behind
   // it): every strategy's density is 0 there, and no choice is made (most
   // directions a BSDF samples miss a light).
-  float pdf(const vec3& o, const vec3& n, const vec3& dir) const {
+  float pdf(const vec3& o, const vec3& n, const vec3& dir, const auto_footprint* fp) const {
     const float pa = area.pdf(o, dir);
     if (!(pa > 0.0f)) return 0.0f;
-    switch (choice(o, n)) {
+    switch (choice(o, n, fp)) {
       case light_sampling::area: return pa;
       case light_sampling::solid_angle: return solid_angle.pdf(o, dir);
       default: return projected.pdf(o, n, dir);
