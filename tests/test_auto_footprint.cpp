@@ -14,13 +14,14 @@
 
 #include "mcrt/core/rng.hpp"
 #include "mcrt/render/light.hpp"
-#include "mcrt/render/mis_integrator.hpp"
 #include "mcrt/render/renderer.hpp"
 #include "mcrt/render/scene.hpp"
 #include "mcrt/sampling/auto_footprint.hpp"
 #include "mcrt/sampling/auto_strategy.hpp"
 #include "mcrt/samplers/samplers.hpp"
+#include "support/auto_own.hpp"
 #include "support/lambert.hpp"
+#include "support/radiance_estimate.hpp"
 
 namespace {
 
@@ -119,22 +120,16 @@ void check_footprint_agreement(const Shape& shape, const auto_params& params) {
     const vec2 u = rng.uniform2();
     light_sample ls, own;
     const bool got = s.sample(q, n, u, ls, &fp);
-    bool own_got = false;
-    if (c == light_sampling::area) own_got = s.area.sample(q, u, own);
-    if (c == light_sampling::solid_angle) own_got = s.solid_angle.sample(q, u, own);
-    if (c == light_sampling::projected_solid_angle) own_got = s.projected.sample(q, n, u, own);
+    const bool own_got = test::own_sample(s, c, q, n, u, own);
     ASSERT_EQ(got, own_got) << "receiver " << i;
     if (!got) continue;
     ASSERT_EQ(ls.dir, own.dir) << "receiver " << i;
     ASSERT_EQ(ls.pdf, own.pdf) << "receiver " << i;
-    float own_pdf = 0.0f;
-    if (c == light_sampling::area) own_pdf = s.area.pdf(q, ls.dir);
-    if (c == light_sampling::solid_angle) own_pdf = s.solid_angle.pdf(q, ls.dir);
-    if (c == light_sampling::projected_solid_angle) own_pdf = s.projected.pdf(q, n, ls.dir);
-    ASSERT_EQ(s.pdf(q, n, ls.dir, &fp), own_pdf) << "receiver " << i;
+    const float own_density = test::own_pdf(s, c, q, n, ls.dir);
+    ASSERT_EQ(s.pdf(q, n, ls.dir, &fp), own_density) << "receiver " << i;
     // Through the light variant too.
     const light l = s;
-    ASSERT_EQ(pdf(l, q, n, ls.dir, &fp), own_pdf) << "receiver " << i;
+    ASSERT_EQ(pdf(l, q, n, ls.dir, &fp), own_density) << "receiver " << i;
     ++sampled;
   }
   EXPECT_GT(sampled, 1000);
@@ -194,26 +189,8 @@ TEST(AutoFootprint, FloorRadianceUnbiased) {
     dearer += s.choice(o, up, &fp) != s.choice(o, up);
     for (const integrator_kind ik : {integrator_kind::nee, integrator_kind::mis})
       for (const sampler_kind sk : {sampler_kind::sobol, sampler_kind::independent}) {
-        const auto estimate = [&]<class I>() {
-          return with_sampler(sk, [&]<class S>() {
-            const S sampler(500 + id, samples);
-            double m = 0.0, m2 = 0.0;
-            for (int k = 0; k < replicates; ++k) {
-              auto ps = sampler.start_pixel(id, k, 64);
-              double sum = 0.0;
-              for (int i = 0; i < samples; ++i) {
-                ps.start_sample(i);
-                sum += I::li(sc, ray{{x, 0.5f, z}, {0, -1, 0}}, ps, set, &fp).r;
-              }
-              m += sum / samples, m2 += (sum / samples) * (sum / samples);
-            }
-            m /= replicates;
-            const double var = std::max(m2 / replicates - m * m, 0.0) * replicates / (replicates - 1);
-            return std::pair{m, std::sqrt(var / replicates)};
-          });
-        };
-        const auto [mean, se] = ik == integrator_kind::nee ? estimate.template operator()<nee_integrator>()
-                                                           : estimate.template operator()<mis_integrator>();
+        const auto [mean, se] = test::radiance_along(sc, ray{{x, 0.5f, z}, {0, -1, 0}}, set, ik, sk, replicates,
+                                                     samples, id, 500 + id, &fp);
         const std::string what = "(" + std::to_string(x) + ", " + std::to_string(z) + ") " + std::string(to_string(sk));
         EXPECT_LE(std::abs(mean - exact), std::max(6.0 * se, 1e-6 * exact)) << what << " mean " << mean << " exact " << exact;
         EXPECT_LE(std::abs(mean - exact), 0.01 * exact) << what;

@@ -20,6 +20,7 @@
 #include "mcrt/core/rng.hpp"
 #include "mcrt/render/light.hpp"
 #include "mcrt/sampling/auto_strategy.hpp"
+#include "support/auto_own.hpp"
 #include "support/chi2.hpp"
 #include "support/lambert.hpp"
 #include "support/solid_angle.hpp"
@@ -566,28 +567,19 @@ void check_agreement(const Shape& shape, const auto_params& params = {}, bool ar
     // pdf() of a direction towards the light's side, hit or miss (it skips
     // the choice where the area density is 0): the chosen strategy's.
     const vec3 rd = glm::normalize(-dir + 0.7f * vec3(2 * rng.uniform() - 1, 2 * rng.uniform() - 1, 2 * rng.uniform() - 1));
-    float own_rd = 0.0f;
-    if (c == light_sampling::area) own_rd = s.area.pdf(o, rd);
-    if (c == light_sampling::solid_angle) own_rd = s.solid_angle.pdf(o, rd);
-    if (c == light_sampling::projected_solid_angle) own_rd = s.projected.pdf(o, n, rd);
+    const float own_rd = test::own_pdf(s, c, o, n, rd);
     ASSERT_EQ(s.pdf(o, n, rd), own_rd) << "receiver " << i << ", direction " << rd.x << " " << rd.y << " " << rd.z;
     const vec2 u = rng.uniform2();
     light_sample ls, own;
     const bool got = s.sample(o, n, u, ls);
-    bool own_got = false;
-    if (c == light_sampling::area) own_got = s.area.sample(o, u, own);
-    if (c == light_sampling::solid_angle) own_got = s.solid_angle.sample(o, u, own);
-    if (c == light_sampling::projected_solid_angle) own_got = s.projected.sample(o, n, u, own);
+    const bool own_got = test::own_sample(s, c, o, n, u, own);
     ASSERT_EQ(got, own_got) << "receiver " << i;
     if (!got) continue;
     ASSERT_EQ(ls.dir, own.dir) << "receiver " << i;
     ASSERT_EQ(ls.pdf, own.pdf) << "receiver " << i;
     const float p = s.pdf(o, n, ls.dir);
-    float own_pdf = 0.0f;
-    if (c == light_sampling::area) own_pdf = s.area.pdf(o, ls.dir);
-    if (c == light_sampling::solid_angle) own_pdf = s.solid_angle.pdf(o, ls.dir);
-    if (c == light_sampling::projected_solid_angle) own_pdf = s.projected.pdf(o, n, ls.dir);
-    ASSERT_EQ(p, own_pdf) << "receiver " << i;
+    const float own_density = test::own_pdf(s, c, o, n, ls.dir);
+    ASSERT_EQ(p, own_density) << "receiver " << i;
     ++sampled;
     if (p == 0.0f) {
       ++off;

@@ -19,9 +19,11 @@ struct estimate {
   double mean, stderr_;
 };
 
+// fp: a pixel's footprint for the lights `auto` samples at the ray's first
+// surface (sampling/auto_footprint.hpp), where the integrator takes one.
 template <class I, class S>
 estimate radiance_along(const scene& sc, const ray& r, const path_settings& set, int replicates, int samples,
-                        int point_id, std::uint64_t seed) {
+                        int point_id, std::uint64_t seed, const auto_footprint* fp = nullptr) {
   const S sampler(seed, samples);
   double s = 0.0, s2 = 0.0;
   for (int k = 0; k < replicates; ++k) {
@@ -29,7 +31,10 @@ estimate radiance_along(const scene& sc, const ray& r, const path_settings& set,
     double sum = 0.0;
     for (int i = 0; i < samples; ++i) {
       ps.start_sample(i);
-      sum += I::li(sc, r, ps, set).r;
+      if constexpr (requires { I::li(sc, r, ps, set, fp); })
+        sum += I::li(sc, r, ps, set, fp).r;
+      else
+        sum += I::li(sc, r, ps, set).r;
     }
     const double m = sum / samples;
     s += m;
@@ -42,10 +47,11 @@ estimate radiance_along(const scene& sc, const ray& r, const path_settings& set,
 
 // The same with the integrator and the sample generator chosen at run time.
 inline estimate radiance_along(const scene& sc, const ray& r, const path_settings& set, integrator_kind ik,
-                               sampler_kind sk, int replicates, int samples, int point_id, std::uint64_t seed) {
+                               sampler_kind sk, int replicates, int samples, int point_id, std::uint64_t seed,
+                               const auto_footprint* fp = nullptr) {
   return with_integrator(ik, [&]<class I>() {
     return with_sampler(sk, [&]<class S>() {
-      return radiance_along<I, S>(sc, r, set, replicates, samples, point_id, seed);
+      return radiance_along<I, S>(sc, r, set, replicates, samples, point_id, seed, fp);
     });
   });
 }

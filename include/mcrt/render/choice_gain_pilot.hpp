@@ -306,6 +306,27 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
             a.noise_share_model = s.noise_share(models);
             const double reflected = v > 0.0 ? std::clamp(1.0 - noise.edge_variance / v, 0.0, 1.0) : 1.0;
             a.noise_share = std::clamp(std::max(measured, a.noise_share_model), 0.0, reflected);
+            // The pilot's pixels where `light` takes a dearer strategy than
+            // the cheapest (at most `pixels`, evenly spaced among them).
+            const auto dearer_pixels = [&](const S& light) {
+              std::vector<edge_pixel> dearer;
+              for (std::size_t k = 0; k < noise.receivers.size(); ++k)
+                if (light.choice(noise.receivers[k].p, noise.receivers[k].n) != s.cheapest())
+                  dearer.push_back(noise.receiver_pixels[k]);
+              return evenly_spaced(dearer, pixels);
+            };
+            // kappa (header) of `light` at those pixels, into a. Measured on
+            // the first bounce's light samples; at deeper bounces the
+            // sequence leaves about all of the light's noise, so over a
+            // path's light samples kappa is the first bounce's share of them
+            // times kappa plus the rest.
+            const auto measure_kappa = [&](const S& light, std::span<const edge_pixel> at) {
+              const auto kappa_start = std::chrono::steady_clock::now();
+              a.kappa_first_bounce = choice_gain_factor(sc, cam, rs, light, at);
+              a.kappa_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - kappa_start).count();
+              const double f = std::clamp(noise.first_bounce_share, 0.0, 1.0);
+              a.kappa = f * a.kappa_first_bounce + (1.0 - f);
+            };
             if (p.pdf_with_sample) {
               // nee (header): the first-order rule with kappa measured, where
               // the choice pays with V.
@@ -313,20 +334,7 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
                 rebuilt = with_cost;
                 return;
               }
-              std::vector<edge_pixel> dearer;
-              for (std::size_t k = 0; k < noise.receivers.size(); ++k)
-                if (with_cost.choice(noise.receivers[k].p, noise.receivers[k].n) != s.cheapest())
-                  dearer.push_back(noise.receiver_pixels[k]);
-              const std::vector<edge_pixel> chosen = evenly_spaced(dearer, pixels);
-              // Measured on the first bounce's light samples; at deeper
-              // bounces the sequence leaves about all of the light's noise,
-              // so over a path's light samples kappa is the first bounce's
-              // share of them times kappa plus the rest.
-              const auto kappa_start = std::chrono::steady_clock::now();
-              a.kappa_first_bounce = choice_gain_factor(sc, cam, rs, with_cost, chosen);
-              a.kappa_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - kappa_start).count();
-              const double f = std::clamp(noise.first_bounce_share, 0.0, 1.0);
-              a.kappa = f * a.kappa_first_bounce + (1.0 - f);
+              measure_kappa(with_cost, dearer_pixels(with_cost));
               a.rest_noise = v * (1.0 - a.noise_share);
               a.image_variance = a.kappa > 0.0 ? v * (1.0 - (1.0 - a.kappa) * a.noise_share) / a.kappa
                                                : double(std::numeric_limits<float>::max());
@@ -353,17 +361,9 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
             // light's noise than of the rest (header).
             if (rs.sampler != sampler_kind::independent) {
               const S settled = s.with_params(p);
-              std::vector<edge_pixel> dearer;
-              for (std::size_t k = 0; k < noise.receivers.size(); ++k)
-                if (settled.choice(noise.receivers[k].p, noise.receivers[k].n) != s.cheapest())
-                  dearer.push_back(noise.receiver_pixels[k]);
+              const std::vector<edge_pixel> dearer = dearer_pixels(settled);
               if (!dearer.empty()) {
-                const auto kappa_start = std::chrono::steady_clock::now();
-                a.kappa_first_bounce = choice_gain_factor(sc, cam, rs, settled, evenly_spaced(dearer, pixels));
-                a.kappa_seconds =
-                    std::chrono::duration<double>(std::chrono::steady_clock::now() - kappa_start).count();
-                const double f = std::clamp(noise.first_bounce_share, 0.0, 1.0);
-                a.kappa = f * a.kappa_first_bounce + (1.0 - f);
+                measure_kappa(settled, dearer);
                 const double kappa_rest = rest_sequence_factor(rs);
                 if (a.kappa > 0.0 && a.kappa < kappa_rest) {
                   a.rest_weight = kappa_rest / a.kappa;

@@ -91,12 +91,19 @@ color camera_sample(const Scene& sc, const camera& cam, PixelSampler& ps, int x,
 }
 
 // Where the pinhole ray through the film point (x + j.x, y + j.y) first
-// meets a surface: its spawn point and facing shading normal.
+// meets a surface: its spawn point and facing shading normal. Out of line
+// (GCC's and Clang's noinline; about one call per pixel): a corner that
+// tile_footprints and pixel_footprint both reach, from the same film point,
+// is then the same to the bit, whatever contractions each caller's inlined
+// copy would have made.
 struct footprint_corner {
   bool hit = false;
   vec3 o{0.0f}, n{0.0f};
 };
 template <class Scene>
+#if defined(__GNUC__) || defined(__clang__)
+[[gnu::noinline]]
+#endif
 footprint_corner corner_seen(const Scene& sc, const camera& cam, int x, int y, vec2 j, float inv_w, float inv_h) {
   const ray r = pixel_ray(cam, x, y, j, inv_w, inv_h);
   hit_record rec;
