@@ -10,9 +10,17 @@
 //     free where nothing is occluded (bench/light_select_variance.cpp: its
 //     V is 0). It costs O(N) per point and per density, so it is a floor
 //     to compare with, not a selection to render with.
+//   - exact-m2: P_k proportional to the square root of light k's own
+//     second moment (Veach 1997, sec. 9.2), which weighs each light's own
+//     sampling noise as well as its contribution: the best one-sample
+//     selection for nee blind to visibility;
+//   - exact-mis: the `exact` P_k re-chosen, for the 32 largest, to minimise
+//     the unoccluded variance of mis's light and material samples together
+//     (optimise_mis below): a selection that gives a light the material's
+//     samples already cover less of the light's.
 // With equal samples, the ratio of power's variance to a selection's is the
 // efficiency that selection would gain over power if it cost no more: for
-// `exact`, the most any selection blind to visibility can gain.
+// the exact ones, about the most a selection blind to visibility can gain.
 //
 // The estimators are the renderer's (render/nee_integrator.hpp) at one
 // vertex: nee takes one light sample, f cos / (pi p_L(dir)), p_L the
@@ -49,6 +57,8 @@ using namespace mcrt;
 
 namespace {
 
+double channel_mean(const color& c) { return (double(c.r) + c.g + c.b) / 3.0; }
+
 // The exact selection at a point: P_k over the scene's lights (index as in
 // sc.lights), its CDF over the emitters with P_k > 0.
 struct exact_selection {
@@ -56,10 +66,35 @@ struct exact_selection {
   std::vector<std::size_t> lights;
   std::vector<double> cdf;
 
-  exact_selection(const scene& sc, const vec3& o, const vec3& n) : prob(sc.lights.size(), 0.0) {
+  // second_moment: P_k proportional to the square root of the second moment
+  // of light k's own unoccluded estimate L cos+ / (pi p_k) (estimated with
+  // `m2_samples` of its sampler's stratified samples), the selection that
+  // minimises the one-sample estimate's variance when each light's own
+  // noise counts (Veach 1997, sec. 9.2: p_k ~ sqrt(E[f_k^2 / p_k])).
+  exact_selection(const scene& sc, const vec3& o, const vec3& n, bool second_moment = false, int m2_samples = 64)
+      : prob(sc.lights.size(), 0.0) {
     double total = 0.0;
+    const int side = std::max(1, static_cast<int>(std::sqrt(double(m2_samples))));
+    pcg32 m2_rng(0x9e3779b97f4a7c15ull ^ std::uint64_t(std::abs(o.x) * 1e6f + std::abs(o.z) * 1e3f), 5);
     for (const emitter& e : sc.emitters) {
-      const double c = std::max(exact_importance(sc.lights[e.light], e.power, o, n, false), 0.0);
+      double c = std::max(exact_importance(sc.lights[e.light], e.power, o, n, false), 0.0);
+      if (second_moment && c > 0.0) {
+        const light& l = sc.lights[e.light];
+        const double area = dispatch(l, [](const auto& sh) { return double(surface_area(sh.shape)); });
+        const double radiance = double(e.power) / (pi * area);  // the luminance exact_importance takes
+        double m2 = 0.0;
+        for (int a = 0; a < side; ++a)
+          for (int b = 0; b < side; ++b) {
+            const vec2 u{(float(a) + m2_rng.uniform()) / float(side), (float(b) + m2_rng.uniform()) / float(side)};
+            light_sample ls;
+            if (!sample(l, o, n, u, ls) || !(ls.pdf > 0.0f)) continue;
+            const double cs = glm::dot(ls.dir, n);
+            if (!(cs > 0.0)) continue;
+            const double g = radiance * cs * inv_pi / double(ls.pdf);
+            m2 += g * g;
+          }
+        c = std::sqrt(m2 / double(side * side));
+      }
       if (!(c > 0.0)) continue;
       prob[e.light] += c;
       lights.push_back(e.light);
@@ -69,6 +104,75 @@ struct exact_selection {
     if (!(total > 0.0)) return;
     for (double& p : prob) p /= total;
     for (double& c : cdf) c /= total;
+  }
+
+  // mis: re-chooses the `top` largest P_k to minimise the one-sample mis
+  // estimate's unoccluded variance, sum_k V_k(P_k) with
+  //   V_k(P) = E_{p_k}[(f w_l / p_k)^2] / P + E_{p_b}[1_k (L w_b)^2],
+  // w_l = (P p_k)^2 / ((P p_k)^2 + p_b^2) and w_b = 1 - w_l (power
+  // heuristic, lights apart in direction), p_b = cos / pi, both expectations
+  // from `samples` of light k's sampler (the second by p_b / p_k). The
+  // others keep their share. Lagrange: V_k'(P_k) = -lambda, by bisection on
+  // lambda and a search on log P per light.
+  void optimise_mis(const scene& sc, const vec3& o, const vec3& n, const std::vector<double>& radiance_of,
+                    int top = 32, int samples = 256) {
+    if (lights.empty()) return;
+    std::vector<std::size_t> order = lights;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return prob[a] > prob[b]; });
+    order.resize(std::min<std::size_t>(order.size(), static_cast<std::size_t>(top)));
+    double budget = 0.0;
+    for (const std::size_t k : order) budget += prob[k];
+    struct term { double a, r, l2; };
+    std::vector<std::vector<term>> t(order.size());
+    const int side = std::max(1, static_cast<int>(std::sqrt(double(samples))));
+    pcg32 rng(0x51ed27u ^ std::uint64_t(std::abs(o.x) * 1e6f + std::abs(o.z) * 1e3f), 9);
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      const light& l = sc.lights[order[i]];
+      const double radiance = radiance_of[order[i]];
+      for (int a = 0; a < side; ++a)
+        for (int b = 0; b < side; ++b) {
+          const vec2 u{(float(a) + rng.uniform()) / float(side), (float(b) + rng.uniform()) / float(side)};
+          light_sample ls;
+          if (!sample(l, o, n, u, ls) || !(ls.pdf > 0.0f)) { t[i].push_back({0, 0, 0}); continue; }
+          const double cs = glm::dot(ls.dir, n);
+          if (!(cs > 0.0)) { t[i].push_back({0, 0, 0}); continue; }
+          const double f = radiance * cs * inv_pi, pk = ls.pdf, pb = cs * inv_pi;
+          t[i].push_back({f / pk, pb / pk, radiance * radiance});
+        }
+    }
+    const auto v = [&](std::size_t i, double P) {
+      double s = 0.0;
+      for (const term& x : t[i]) {
+        if (x.l2 == 0.0) continue;
+        // x.r = p_b / p_k; w_l = P^2 / (P^2 + r^2).
+        const double w = P * P / (P * P + x.r * x.r);
+        s += x.a * x.a * w * w / P + x.l2 * (1.0 - w) * (1.0 - w) * x.r;
+      }
+      return s / double(t[i].size());
+    };
+    const auto best_p = [&](std::size_t i, double lambda) {
+      double lo = std::log(1e-7), hi = std::log(budget);
+      for (int it = 0; it < 60; ++it) {
+        const double m1 = lo + (hi - lo) / 3.0, m2 = hi - (hi - lo) / 3.0;
+        const double f1 = v(i, std::exp(m1)) + lambda * std::exp(m1), f2 = v(i, std::exp(m2)) + lambda * std::exp(m2);
+        if (f1 < f2) hi = m2; else lo = m1;
+      }
+      return std::exp(0.5 * (lo + hi));
+    };
+    double llo = 1e-12, lhi = 1e12;
+    std::vector<double> p(order.size());
+    for (int it = 0; it < 60; ++it) {
+      const double lambda = std::sqrt(llo * lhi);
+      double sum = 0.0;
+      for (std::size_t i = 0; i < order.size(); ++i) sum += (p[i] = best_p(i, lambda));
+      if (sum > budget) llo = lambda; else lhi = lambda;
+    }
+    double sum = 0.0;
+    for (const double x : p) sum += x;
+    for (std::size_t i = 0; i < order.size(); ++i) prob[order[i]] = p[i] * budget / sum;
+    double c = 0.0;
+    for (std::size_t i = 0; i < lights.size(); ++i) cdf[i] = (c += prob[lights[i]]);
+    for (double& x : cdf) x /= c;
   }
   bool empty() const { return lights.empty(); }
   std::ptrdiff_t pick(double u, double& p) const {
@@ -85,11 +189,14 @@ struct exact_selection {
   }
 };
 
-// A selection: the renderer's (how) or the exact one (exact = true).
+// A selection: the renderer's (how) or the exact one (exact = true;
+// second_moment: by each light's own second moment).
 struct selector {
   const char* name;
   light_choice how;
   bool exact;
+  bool second_moment = false;
+  bool mis_optimal = false;
 };
 
 struct moments {
@@ -98,8 +205,6 @@ struct moments {
   double mean() const { return sum / n; }
   double variance() const { return n > 1 ? std::max(0.0, (sum2 - sum * sum / n) / (n - 1)) : 0.0; }
 };
-
-double channel_mean(const color& c) { return (double(c.r) + c.g + c.b) / 3.0; }
 
 }  // namespace
 
@@ -134,12 +239,17 @@ int main(int argc, char** argv) {
   const selector selectors[] = {{"power", light_choice::power, false},
                                 {"pbrt-bvh", light_choice::pbrt_bvh, false},
                                 {"bvh", light_choice::bvh, false},
-                                {"exact", light_choice::power, true}};
-  constexpr int ns = 4;
+                                {"exact", light_choice::power, true},
+                                {"exact-m2", light_choice::power, true, true},
+                                {"exact-mis", light_choice::power, true, false, true}};
+  constexpr int ns = 6;
   // Per integrator (0 nee, 1 mis) and selection: summed over points.
   double var_sum[2][ns] = {}, mean_sum[2][ns] = {};
   double seconds[ns] = {};
   int used = 0;
+  std::vector<double> radiance_of(sc.lights.size(), 0.0);  // luminance by light
+  for (const emitter& e : sc.emitters)
+    radiance_of[e.light] = double(e.power) / (pi * dispatch(sc.lights[e.light], [](const auto& sh) { return double(surface_area(sh.shape)); }));
   pcg32 point_rng(seed, 7);
   const std::vector<bench::receiver> receivers = bench::make_receivers(b, kind, points, point_rng, 1e-4f);
   for (int i = 0; i < static_cast<int>(receivers.size()); ++i) {
@@ -152,7 +262,8 @@ int main(int argc, char** argv) {
       pcg32 rng(seed * 1000003u + static_cast<std::uint64_t>(i), 11);  // the same numbers for every selection
       const light_selection sel(sc, o, n, s.how);
       std::optional<exact_selection> ex;
-      if (s.exact) ex.emplace(sc, o, n);
+      if (s.exact) ex.emplace(sc, o, n, s.second_moment);
+      if (s.mis_optimal) ex->optimise_mis(sc, o, n, radiance_of);
       const auto p_light = [&](const vec3& dir, std::ptrdiff_t k, float pk) {
         return ex ? ex->pdf(sc, o, n, dir) : double(sel.pdf(dir, k, pk));
       };
