@@ -320,13 +320,13 @@ TEST(ChoiceGainPilot, SettleWeighsEachAutoLight) {
         << "the lights as they were";
     const double floor = v * at_v.mis_floor(models);
     EXPECT_EQ(low.edge_variance, 0.0) << "the reflected part alone";
-    EXPECT_NEAR(a[0].rest_noise, std::max(low.reflected_median_of_means + noise.edge_variance, floor), 1e-6 * v)
+    EXPECT_NEAR(a[0].rest_noise, std::max(low.image_variance + noise.edge_variance, floor), 1e-6 * v)
         << to_string(kind);
     EXPECT_GE(a[0].rest_noise, floor);
     EXPECT_GT(a[0].rest_pilot_seconds, 0.0);
     // With Sobol points R weighed by kappa_R / kappa_l, kappa_l measured
     // at the choice (the light's gain, which the points leave less of).
-    const double rest = a[0].weighed_rest_noise(floor, low.reflected_median_of_means + noise.edge_variance);
+    const double rest = a[0].weighed_rest_noise(floor, low.image_variance + noise.edge_variance);
     if (kind == sampler_kind::independent) {
       EXPECT_EQ(a[0].rest_weight, 1.0);
       EXPECT_NEAR(rest, a[0].rest_noise, 1e-6 * v);

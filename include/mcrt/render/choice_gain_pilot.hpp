@@ -46,13 +46,7 @@
 // 0.97-1.05x the best fixed strategy there). With the light's own noise
 // small, the rest is steady (under a sliver of aspect 10^4, over 6 pilot
 // seeds, R varies 3.1x where V varies 68x). The second pilot is part of
-// auto's time. Its reflected part is taken as a median of means
-// (noise_pilot_result::reflected_median_of_means): the few pixels of large
-// variance it meets at some seeds and not at others (a shadow's penumbra,
-// an edge in view) made R 3-15x its usual size at 4 of 16 seeds under
-// tri_distance_h3 (mis, Sobol, 8 spp), and those renders had 1.4-3.3x
-// projected solid angle's error; R fixed by hand at its usual size gave
-// about the highest efficiency there (docs/auto.md).
+// auto's time.
 // Without the floor V b, where the rest is all the light's (a bare floor
 // under it) R would be 0, V_l would fall to 0 and projected solid angle
 // (modelled variance 0) would be taken everywhere at any cost (2.2x slower
@@ -357,8 +351,7 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
             }
             a.rest_pilot_seconds = low_seconds;
             low_seconds = 0.0;
-            const double low_reflected = low->reflected_median_of_means;
-            a.rest_noise = std::max(low_reflected + noise.edge_variance, v * s.mis_floor(models));
+            a.rest_noise = std::max(low->image_variance + noise.edge_variance, v * s.mis_floor(models));
             const auto_params start = p;
             a.fixed_point_steps = settle_fixed_point(s, noise.receivers, models, v, a.noise_share, a.rest_noise,
                                                      a.rest_cost, p);
@@ -376,7 +369,7 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
                   a.rest_weight = kappa_rest / a.kappa;
                   p = start;
                   const double weighed = a.weighed_rest_noise(v * s.mis_floor(models),
-                                                              low_reflected + noise.edge_variance);
+                                                              low->image_variance + noise.edge_variance);
                   a.fixed_point_steps =
                       settle_fixed_point(s, noise.receivers, models, v, a.noise_share, weighed, a.rest_cost, p);
                 }

@@ -72,7 +72,6 @@
 // rest of the pilot (seconds_per_light_sample: reported, not used, as a
 // check of that model on the machine at hand).
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -265,12 +264,6 @@ struct edge_pixel {
 struct noise_pilot_result {
   double image_variance = 0.0;  // mean variance of one pixel sample, radiance^2
   double edge_variance = 0.0;   // of which the mean of s2_K(E): what the camera rays meet first (header)
-  // The reflected part of image_variance (image_variance - edge_variance)
-  // as a median of means: the median over 8 groups of the pilot's rows
-  // (row j in group j mod 8) of each group's weighted mean; the mean itself
-  // where the pilot has fewer than 8 rows. Robust to a few pixels of large
-  // variance (the image's edges, a shadow's penumbra), which it leaves out.
-  double reflected_median_of_means = 0.0;
   double mean_albedo2 = 1.0;    // mean squared albedo (of the channels' mean) the camera sees on diffuse surfaces
   double seconds = 0.0;         // wall-clock time of the pilot
   int pixels = 0;               // pixels measured
@@ -564,25 +557,6 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
   }
   out.edge_variance = edge_sum / (double(rs.width) * rs.height);
   if (weights > 0.0) out.image_variance = sum / weights + out.edge_variance;
-  {
-    constexpr int groups = 8;
-    if (ny >= groups) {
-      std::array<double, groups> gs{}, gw{};
-      for (int j = 0; j < ny; ++j)
-        gs[static_cast<std::size_t>(j % groups)] += row_sums[static_cast<std::size_t>(j)],
-            gw[static_cast<std::size_t>(j % groups)] += row_weights[static_cast<std::size_t>(j)];
-      std::vector<double> means;
-      for (int g = 0; g < groups; ++g)
-        if (gw[static_cast<std::size_t>(g)] > 0.0) means.push_back(gs[static_cast<std::size_t>(g)] / gw[static_cast<std::size_t>(g)]);
-      if (!means.empty()) {
-        std::sort(means.begin(), means.end());
-        const std::size_t h = means.size() / 2;
-        out.reflected_median_of_means = means.size() % 2 ? means[h] : 0.5 * (means[h - 1] + means[h]);
-      }
-    } else if (weights > 0.0) {
-      out.reflected_median_of_means = sum / weights;
-    }
-  }
   out.light_variance.resize(nl, 0.0);
   for (double& v : out.light_variance) v = weights > 0.0 ? v / weights : 0.0;
   double path_seconds = 0.0;
