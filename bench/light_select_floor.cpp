@@ -59,6 +59,38 @@ namespace {
 
 double channel_mean(const color& c) { return (double(c.r) + c.g + c.b) / 3.0; }
 
+// A seed for the numbers drawn at the receiver o (its position, hashed).
+std::uint64_t point_hash(const vec3& o) { return std::uint64_t(std::abs(o.x) * 1e6f + std::abs(o.z) * 1e3f); }
+
+// One sample of a light's own sampler at o (normal n), unoccluded: its
+// estimate f / p_k = L cos+ / (pi p_k) and p_b / p_k, p_b = cos+ / pi the
+// material's cosine density; both 0 where the sampler offers nothing or the
+// direction is below the horizon.
+struct light_draw {
+  double f_over_p = 0.0, pb_over_p = 0.0;
+};
+
+// side x side stratified samples of light l (side = floor(sqrt(samples))),
+// radiance its luminance.
+std::vector<light_draw> light_draws(const light& l, double radiance, const vec3& o, const vec3& n, int samples,
+                                    pcg32& rng) {
+  const int side = std::max(1, static_cast<int>(std::sqrt(double(samples))));
+  std::vector<light_draw> out;
+  out.reserve(static_cast<std::size_t>(side * side));
+  for (int a = 0; a < side; ++a)
+    for (int b = 0; b < side; ++b) {
+      const vec2 u{(float(a) + rng.uniform()) / float(side), (float(b) + rng.uniform()) / float(side)};
+      light_sample ls;
+      light_draw d;
+      if (sample(l, o, n, u, ls) && ls.pdf > 0.0f) {
+        const double cs = glm::dot(ls.dir, n);
+        if (cs > 0.0) d = {radiance * cs * inv_pi / double(ls.pdf), cs * inv_pi / double(ls.pdf)};
+      }
+      out.push_back(d);
+    }
+  return out;
+}
+
 // The exact selection at a point: P_k over the scene's lights (index as in
 // sc.lights), its CDF over the emitters with P_k > 0.
 struct exact_selection {
@@ -67,33 +99,23 @@ struct exact_selection {
   std::vector<double> cdf;
 
   // second_moment: P_k proportional to the square root of the second moment
-  // of light k's own unoccluded estimate L cos+ / (pi p_k) (estimated with
-  // `m2_samples` of its sampler's stratified samples), the selection that
-  // minimises the one-sample estimate's variance when each light's own
-  // noise counts (Veach 1997, sec. 9.2: p_k ~ sqrt(E[f_k^2 / p_k])).
-  exact_selection(const scene& sc, const vec3& o, const vec3& n, bool second_moment = false, int m2_samples = 64)
+  // of light k's own unoccluded estimate L cos+ / (pi p_k) (from
+  // `m2_samples` of its sampler's stratified samples, light_draws), the
+  // selection that minimises the one-sample estimate's variance when each
+  // light's own noise counts (Veach 1997, sec. 9.2: p_k ~ sqrt(E[f_k^2 /
+  // p_k])). radiance_of: each light's luminance, as exact_importance takes it.
+  exact_selection(const scene& sc, const vec3& o, const vec3& n, const std::vector<double>& radiance_of,
+                  bool second_moment = false, int m2_samples = 64)
       : prob(sc.lights.size(), 0.0) {
     double total = 0.0;
-    const int side = std::max(1, static_cast<int>(std::sqrt(double(m2_samples))));
-    pcg32 m2_rng(0x9e3779b97f4a7c15ull ^ std::uint64_t(std::abs(o.x) * 1e6f + std::abs(o.z) * 1e3f), 5);
+    pcg32 m2_rng(0x9e3779b97f4a7c15ull ^ point_hash(o), 5);
     for (const emitter& e : sc.emitters) {
       double c = std::max(exact_importance(sc.lights[e.light], e.power, o, n, false), 0.0);
       if (second_moment && c > 0.0) {
-        const light& l = sc.lights[e.light];
-        const double area = dispatch(l, [](const auto& sh) { return double(surface_area(sh.shape)); });
-        const double radiance = double(e.power) / (pi * area);  // the luminance exact_importance takes
+        const std::vector<light_draw> d = light_draws(sc.lights[e.light], radiance_of[e.light], o, n, m2_samples, m2_rng);
         double m2 = 0.0;
-        for (int a = 0; a < side; ++a)
-          for (int b = 0; b < side; ++b) {
-            const vec2 u{(float(a) + m2_rng.uniform()) / float(side), (float(b) + m2_rng.uniform()) / float(side)};
-            light_sample ls;
-            if (!sample(l, o, n, u, ls) || !(ls.pdf > 0.0f)) continue;
-            const double cs = glm::dot(ls.dir, n);
-            if (!(cs > 0.0)) continue;
-            const double g = radiance * cs * inv_pi / double(ls.pdf);
-            m2 += g * g;
-          }
-        c = std::sqrt(m2 / double(side * side));
+        for (const light_draw& x : d) m2 += x.f_over_p * x.f_over_p;
+        c = std::sqrt(m2 / double(d.size()));
       }
       if (!(c > 0.0)) continue;
       prob[e.light] += c;
@@ -122,31 +144,18 @@ struct exact_selection {
     order.resize(std::min<std::size_t>(order.size(), static_cast<std::size_t>(top)));
     double budget = 0.0;
     for (const std::size_t k : order) budget += prob[k];
-    struct term { double a, r, l2; };
-    std::vector<std::vector<term>> t(order.size());
-    const int side = std::max(1, static_cast<int>(std::sqrt(double(samples))));
-    pcg32 rng(0x51ed27u ^ std::uint64_t(std::abs(o.x) * 1e6f + std::abs(o.z) * 1e3f), 9);
-    for (std::size_t i = 0; i < order.size(); ++i) {
-      const light& l = sc.lights[order[i]];
-      const double radiance = radiance_of[order[i]];
-      for (int a = 0; a < side; ++a)
-        for (int b = 0; b < side; ++b) {
-          const vec2 u{(float(a) + rng.uniform()) / float(side), (float(b) + rng.uniform()) / float(side)};
-          light_sample ls;
-          if (!sample(l, o, n, u, ls) || !(ls.pdf > 0.0f)) { t[i].push_back({0, 0, 0}); continue; }
-          const double cs = glm::dot(ls.dir, n);
-          if (!(cs > 0.0)) { t[i].push_back({0, 0, 0}); continue; }
-          const double f = radiance * cs * inv_pi, pk = ls.pdf, pb = cs * inv_pi;
-          t[i].push_back({f / pk, pb / pk, radiance * radiance});
-        }
-    }
+    std::vector<std::vector<light_draw>> t(order.size());
+    pcg32 rng(0x51ed27u ^ point_hash(o), 9);
+    for (std::size_t i = 0; i < order.size(); ++i)
+      t[i] = light_draws(sc.lights[order[i]], radiance_of[order[i]], o, n, samples, rng);
     const auto v = [&](std::size_t i, double P) {
+      const double l2 = radiance_of[order[i]] * radiance_of[order[i]];
       double s = 0.0;
-      for (const term& x : t[i]) {
-        if (x.l2 == 0.0) continue;
-        // x.r = p_b / p_k; w_l = P^2 / (P^2 + r^2).
-        const double w = P * P / (P * P + x.r * x.r);
-        s += x.a * x.a * w * w / P + x.l2 * (1.0 - w) * (1.0 - w) * x.r;
+      for (const light_draw& x : t[i]) {
+        if (x.f_over_p == 0.0) continue;
+        // w_l = P^2 / (P^2 + r^2), r = p_b / p_k.
+        const double r = x.pb_over_p, w = P * P / (P * P + r * r);
+        s += x.f_over_p * x.f_over_p * w * w / P + l2 * (1.0 - w) * (1.0 - w) * r;
       }
       return s / double(t[i].size());
     };
@@ -189,8 +198,9 @@ struct exact_selection {
   }
 };
 
-// A selection: the renderer's (how) or the exact one (exact = true;
-// second_moment: by each light's own second moment).
+// A selection: the renderer's (how) or an exact one (exact = true;
+// second_moment: by each light's own second moment; mis_optimal: re-chosen
+// for mis, optimise_mis).
 struct selector {
   const char* name;
   light_choice how;
@@ -247,9 +257,10 @@ int main(int argc, char** argv) {
   double var_sum[2][ns] = {}, mean_sum[2][ns] = {};
   double seconds[ns] = {};
   int used = 0;
-  std::vector<double> radiance_of(sc.lights.size(), 0.0);  // luminance by light
+  std::vector<double> radiance_of(sc.lights.size(), 0.0);  // luminance by light (exact_importance's)
   for (const emitter& e : sc.emitters)
-    radiance_of[e.light] = double(e.power) / (pi * dispatch(sc.lights[e.light], [](const auto& sh) { return double(surface_area(sh.shape)); }));
+    radiance_of[e.light] =
+        double(e.power) / (pi * dispatch(sc.lights[e.light], [](const auto& l) { return double(surface_area(l.shape)); }));
   pcg32 point_rng(seed, 7);
   const std::vector<bench::receiver> receivers = bench::make_receivers(b, kind, points, point_rng, 1e-4f);
   for (int i = 0; i < static_cast<int>(receivers.size()); ++i) {
@@ -262,7 +273,7 @@ int main(int argc, char** argv) {
       pcg32 rng(seed * 1000003u + static_cast<std::uint64_t>(i), 11);  // the same numbers for every selection
       const light_selection sel(sc, o, n, s.how);
       std::optional<exact_selection> ex;
-      if (s.exact) ex.emplace(sc, o, n, s.second_moment);
+      if (s.exact) ex.emplace(sc, o, n, radiance_of, s.second_moment);
       if (s.mis_optimal) ex->optimise_mis(sc, o, n, radiance_of);
       const auto p_light = [&](const vec3& dir, std::ptrdiff_t k, float pk) {
         return ex ? ex->pdf(sc, o, n, dir) : double(sel.pdf(dir, k, pk));
