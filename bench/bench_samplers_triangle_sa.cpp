@@ -22,6 +22,7 @@
 #include "mcrt/sampling/triangle_area.hpp"
 #include "observers.hpp"
 #include "pbrt_spherical_triangle_port.inc"
+#include "peters21_sa_port.inc"
 
 namespace {
 
@@ -67,6 +68,40 @@ void BM_FloorPbrtSphericalTriangle(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_FloorPbrtSphericalTriangle);
+
+void BM_FloorPeters21SphericalTriangle(benchmark::State& state) {
+  const mcrt::triangle t = cornell_half_triangle();
+  const std::vector<mcrt::vec3> obs = triangle_observers(t);
+  const mcrt::vec3 p0 = t.vertex(0), p1 = t.vertex(1), p2 = t.vertex(2);
+  mcrt::pcg32 rng(1, 2);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    // Polygon vertices (p1, p0, p2): Arvo's map with A = p0, B = p1, C = p2.
+    const auto s = mcrt::bench::peters21_sa::prepare<float>(p1, p0, p2, obs[i++ & (obs.size() - 1)]);
+    const mcrt::vec3 d = mcrt::bench::peters21_sa::sample<float>(s, rng.uniform2());
+    benchmark::DoNotOptimize(d);
+    benchmark::DoNotOptimize(s.solid_angle);
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_FloorPeters21SphericalTriangle);
+
+// The same in double (the extremes program's fourth column), float in and out.
+void BM_Peters21SphericalTriangleDouble(benchmark::State& state) {
+  const mcrt::triangle t = cornell_half_triangle();
+  const std::vector<mcrt::vec3> obs = triangle_observers(t);
+  const mcrt::dvec3 p0(t.vertex(0)), p1(t.vertex(1)), p2(t.vertex(2));
+  mcrt::pcg32 rng(1, 2);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const auto s = mcrt::bench::peters21_sa::prepare<double>(p1, p0, p2, mcrt::dvec3(obs[i++ & (obs.size() - 1)]));
+    const mcrt::vec3 d(mcrt::bench::peters21_sa::sample<double>(s, mcrt::dvec2(rng.uniform2())));
+    benchmark::DoNotOptimize(d);
+    benchmark::DoNotOptimize(s.solid_angle);
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_Peters21SphericalTriangleDouble);
 
 // As bench::run_sample_and_pdf, with the receiver normal (0, 1, 0).
 template <class Sampler>
