@@ -12,6 +12,8 @@
 #include "mcrt/sampling/rect_area.hpp"
 #include "mcrt/sampling/spherical_ellipse.hpp"
 #include "mcrt/sampling/spherical_rectangle.hpp"
+#include "mcrt/sampling/spherical_triangle.hpp"
+#include "mcrt/sampling/triangle_area.hpp"
 #include "observers.hpp"
 
 namespace {
@@ -51,6 +53,33 @@ void pdf_only(benchmark::State& state, const Sampler& s, const std::vector<vec3>
 
 std::vector<vec3> rect_observers() { return bench::observers_around(bench_rect); }
 std::vector<vec3> ellipse_observers() { return bench::observers_around(bench_ellipse); }
+
+// Half of the Cornell light, as bench_samplers_triangle_sa.cpp.
+triangle bench_triangle() {
+  auto m = std::make_shared<triangle_mesh>();
+  m->p = {{343, 554, 332}, {213, 554, 227}, {343, 554, 227}};
+  m->indices = {0, 1, 2};
+  return {m, 0};
+}
+std::vector<vec3> triangle_observers() {
+  const triangle t = bench_triangle();
+  return bench::observers_around((t.vertex(0) + t.vertex(1) + t.vertex(2)) / 3.0f, t.normal(), 130.0f);
+}
+void BM_TriangleSolidAngleSampleOnly(benchmark::State& st) {
+  sample_only(st, triangle_solid_angle_sampler{bench_triangle()}, triangle_observers());
+}
+void BM_TriangleSolidAnglePdfOnly(benchmark::State& st) {
+  pdf_only(st, triangle_solid_angle_sampler{bench_triangle()}, triangle_observers());
+}
+// The spherical triangle's set-up alone (Omega and the map's constants).
+void BM_TriangleSolidAngleSetup(benchmark::State& state) {
+  const std::vector<vec3> obs = triangle_observers();
+  const triangle t = bench_triangle();
+  const dvec3 p0(t.vertex(0)), p1(t.vertex(1)), p2(t.vertex(2));
+  std::size_t i = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(spherical_triangle(dvec3(obs[i++ & (obs.size() - 1)]), p0, p1, p2));
+  state.SetItemsProcessed(state.iterations());
+}
 
 void BM_RectAreaSampleOnly(benchmark::State& st) { sample_only(st, rect_area_sampler{bench_rect}, rect_observers()); }
 void BM_RectAreaPdfOnly(benchmark::State& st) { pdf_only(st, rect_area_sampler{bench_rect}, rect_observers()); }
@@ -113,5 +142,8 @@ BENCHMARK(BM_EllipseSolidAnglePdfOnly);
 BENCHMARK(BM_EllipseConeSetup);
 BENCHMARK(BM_EllipseSolidAngleOmega);
 BENCHMARK(BM_EllipseSolidAngleSolver);
+BENCHMARK(BM_TriangleSolidAngleSampleOnly);
+BENCHMARK(BM_TriangleSolidAnglePdfOnly);
+BENCHMARK(BM_TriangleSolidAngleSetup);
 
 }  // namespace
