@@ -8,6 +8,9 @@
 //                                 triangles (area-sampled) scattered over
 //                                 a 18 x 3 x 18 box facing down, receivers
 //                                 on the floor below, normal up.
+//   BM_LightBvhBuild/<N>          building the light BVH over those N
+//                                 lights' bounds (light_bvh's constructor,
+//                                 its proxies included).
 #include <benchmark/benchmark.h>
 
 #include <memory>
@@ -21,6 +24,7 @@ struct many {
   std::shared_ptr<mcrt::triangle_mesh> mesh = std::make_shared<mcrt::triangle_mesh>();
   std::vector<mcrt::light> lights;
   std::vector<mcrt::emitter> emitters;
+  std::vector<mcrt::light_bounds> items;
   mcrt::light_bvh tree;
   std::vector<mcrt::vec3> receivers;
 };
@@ -48,9 +52,8 @@ const many& scene_of(int n) {
     s->emitters.push_back({static_cast<std::uint32_t>(s->lights.size()), mcrt::pi * t.area() * radiance});
     s->lights.push_back(l);
   }
-  std::vector<mcrt::light_bounds> items;
-  for (const mcrt::emitter& e : s->emitters) items.push_back(mcrt::bounds_of(s->lights[e.light], e.power));
-  s->tree = mcrt::light_bvh(items);
+  for (const mcrt::emitter& e : s->emitters) s->items.push_back(mcrt::bounds_of(s->lights[e.light], e.power));
+  s->tree = mcrt::light_bvh(s->items);
   for (int i = 0; i < 1024; ++i) s->receivers.push_back({18.0f * (rng.uniform() - 0.5f), 0.0f, 18.0f * (rng.uniform() - 0.5f)});
   cache[static_cast<std::size_t>(slot)] = std::move(s);
   return *cache[static_cast<std::size_t>(slot)];
@@ -76,5 +79,15 @@ void BM_LightSelect(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_LightSelect)->ArgsProduct({{0, 1, 2, 3}, {100, 10000, 100000}});
+
+void BM_LightBvhBuild(benchmark::State& state) {
+  const many& s = scene_of(static_cast<int>(state.range(0)));
+  for (auto _ : state) {
+    const mcrt::light_bvh tree(s.items);
+    benchmark::DoNotOptimize(tree.nodes().data());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(s.items.size()));
+}
+BENCHMARK(BM_LightBvhBuild)->Arg(100)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond);
 
 }  // namespace

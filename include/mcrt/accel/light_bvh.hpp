@@ -256,10 +256,18 @@ class light_bvh {
     for (int dim = 0; dim < 3 && depth + 24 < max_depth; ++dim) {
       if (!(centroids.hi[dim] > centroids.lo[dim])) continue;
       std::array<light_bounds, buckets> bk{};
-      for (std::uint32_t i = begin; i < end; ++i) bk[bucket_of(ids[i], dim)] = unite(bk[bucket_of(ids[i], dim)], items[ids[i]]);
+      for (std::uint32_t i = begin; i < end; ++i) {
+        light_bounds& b = bk[bucket_of(ids[i], dim)];
+        b = unite(b, items[ids[i]]);
+      }
+      // below: buckets 0..s, grown by one bucket per split (the same unions
+      // in the same order as uniting them anew for each s); above: buckets
+      // s + 1.. united in ascending order for each s (unite is not
+      // associative in float, so the tree is the one this order gives).
+      light_bounds below;
       for (int s = 0; s + 1 < buckets; ++s) {
-        light_bounds below, above;
-        for (int b = 0; b <= s; ++b) below = unite(below, bk[b]);
+        below = unite(below, bk[s]);
+        light_bounds above;
         for (int b = s + 1; b < buckets; ++b) above = unite(above, bk[b]);
         if (!(below.phi > 0.0f) || !(above.phi > 0.0f)) continue;
         const float c = cost(below, all.box, dim) + cost(above, all.box, dim);
