@@ -52,54 +52,52 @@ void BM_SampleTriangleArea(benchmark::State& state) {
 }
 BENCHMARK(BM_SampleTriangleArea);
 
-void BM_FloorPbrtSphericalTriangle(benchmark::State& state) {
+// A published map timed as published: map(p0, p1, p2, o, u) over the
+// observers, its direction and density kept from the optimiser.
+template <class Map>
+void run_floor(benchmark::State& state, Map map) {
   const mcrt::triangle t = cornell_half_triangle();
   const std::vector<mcrt::vec3> obs = triangle_observers(t);
   const mcrt::vec3 p0 = t.vertex(0), p1 = t.vertex(1), p2 = t.vertex(2);
   mcrt::pcg32 rng(1, 2);
   std::size_t i = 0;
   for (auto _ : state) {
-    float pdf;
-    const mcrt::vec3 d =
-        mcrt::bench::pbrt_port::sample_spherical_triangle(p0, p1, p2, obs[i++ & (obs.size() - 1)], rng.uniform2(), pdf);
+    float pdf = 0.0f;
+    const mcrt::vec3 d = map(p0, p1, p2, obs[i++ & (obs.size() - 1)], rng.uniform2(), pdf);
     benchmark::DoNotOptimize(d);
     benchmark::DoNotOptimize(pdf);
   }
   state.SetItemsProcessed(state.iterations());
 }
+
+void BM_FloorPbrtSphericalTriangle(benchmark::State& state) {
+  run_floor(state, [](const mcrt::vec3& p0, const mcrt::vec3& p1, const mcrt::vec3& p2, const mcrt::vec3& o,
+                      mcrt::vec2 u, float& pdf) {
+    return mcrt::bench::pbrt_port::sample_spherical_triangle(p0, p1, p2, o, u, pdf);
+  });
+}
 BENCHMARK(BM_FloorPbrtSphericalTriangle);
 
+// Polygon vertices (p1, p0, p2): Arvo's map with A = p0, B = p1, C = p2.
 void BM_FloorPeters21SphericalTriangle(benchmark::State& state) {
-  const mcrt::triangle t = cornell_half_triangle();
-  const std::vector<mcrt::vec3> obs = triangle_observers(t);
-  const mcrt::vec3 p0 = t.vertex(0), p1 = t.vertex(1), p2 = t.vertex(2);
-  mcrt::pcg32 rng(1, 2);
-  std::size_t i = 0;
-  for (auto _ : state) {
-    // Polygon vertices (p1, p0, p2): Arvo's map with A = p0, B = p1, C = p2.
-    const auto s = mcrt::bench::peters21_sa::prepare<float>(p1, p0, p2, obs[i++ & (obs.size() - 1)]);
-    const mcrt::vec3 d = mcrt::bench::peters21_sa::sample<float>(s, rng.uniform2());
-    benchmark::DoNotOptimize(d);
-    benchmark::DoNotOptimize(s.solid_angle);
-  }
-  state.SetItemsProcessed(state.iterations());
+  run_floor(state, [](const mcrt::vec3& p0, const mcrt::vec3& p1, const mcrt::vec3& p2, const mcrt::vec3& o,
+                      mcrt::vec2 u, float& pdf) {
+    const auto s = mcrt::bench::peters21_sa::prepare<float>(p1, p0, p2, o);
+    pdf = 1.0f / s.solid_angle;
+    return mcrt::bench::peters21_sa::sample<float>(s, u);
+  });
 }
 BENCHMARK(BM_FloorPeters21SphericalTriangle);
 
 // The same in double (the extremes program's fourth column), float in and out.
 void BM_Peters21SphericalTriangleDouble(benchmark::State& state) {
-  const mcrt::triangle t = cornell_half_triangle();
-  const std::vector<mcrt::vec3> obs = triangle_observers(t);
-  const mcrt::dvec3 p0(t.vertex(0)), p1(t.vertex(1)), p2(t.vertex(2));
-  mcrt::pcg32 rng(1, 2);
-  std::size_t i = 0;
-  for (auto _ : state) {
-    const auto s = mcrt::bench::peters21_sa::prepare<double>(p1, p0, p2, mcrt::dvec3(obs[i++ & (obs.size() - 1)]));
-    const mcrt::vec3 d(mcrt::bench::peters21_sa::sample<double>(s, mcrt::dvec2(rng.uniform2())));
-    benchmark::DoNotOptimize(d);
-    benchmark::DoNotOptimize(s.solid_angle);
-  }
-  state.SetItemsProcessed(state.iterations());
+  run_floor(state, [](const mcrt::vec3& p0, const mcrt::vec3& p1, const mcrt::vec3& p2, const mcrt::vec3& o,
+                      mcrt::vec2 u, float& pdf) {
+    const auto s = mcrt::bench::peters21_sa::prepare<double>(mcrt::dvec3(p1), mcrt::dvec3(p0), mcrt::dvec3(p2),
+                                                             mcrt::dvec3(o));
+    pdf = static_cast<float>(1.0 / s.solid_angle);
+    return mcrt::vec3(mcrt::bench::peters21_sa::sample<double>(s, mcrt::dvec2(u)));
+  });
 }
 BENCHMARK(BM_Peters21SphericalTriangleDouble);
 

@@ -18,8 +18,6 @@
 // over the triangle's angular size sqrt(S). Prints a markdown table.
 //
 //   build/mcrt_triangle_sa_extremes [N]     (default 100000)
-#include <boost/math/constants/constants.hpp>
-#include <boost/multiprecision/cpp_bin_float.hpp>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -31,51 +29,14 @@
 #include "mcrt/sampling/spherical_triangle.hpp"
 #include "pbrt_spherical_triangle_port.inc"
 #include "peters21_sa_port.inc"
+#include "support/spherical_triangle_reference.hpp"
 
 namespace {
 
 using namespace mcrt;
 
-// ---- 50-digit references (as tests/test_spherical_triangle.cpp)
-using mp = boost::multiprecision::cpp_bin_float_50;
-struct v3 {
-  mp x, y, z;
-};
-v3 to_mp(const dvec3& p) { return {p.x, p.y, p.z}; }
-v3 operator-(const v3& a, const v3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-v3 operator+(const v3& a, const v3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-v3 operator*(const mp& s, const v3& a) { return {s * a.x, s * a.y, s * a.z}; }
-mp dot(const v3& a, const v3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-v3 cross(const v3& a, const v3& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-mp norm(const v3& a) { return sqrt(dot(a, a)); }
-v3 unit(const v3& a) { return (1 / norm(a)) * a; }
-dvec3 to_d(const v3& a) { return {static_cast<double>(a.x), static_cast<double>(a.y), static_cast<double>(a.z)}; }
-
-double reference_solid_angle(const dvec3& o, const dvec3& p0, const dvec3& p1, const dvec3& p2) {
-  const v3 oo = to_mp(o), a = to_mp(p0) - oo, b = to_mp(p1) - oo, c = to_mp(p2) - oo;
-  const mp la = norm(a), lb = norm(b), lc = norm(c);
-  return static_cast<double>(
-      2 * atan2(abs(dot(a, cross(b, c))), la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la));
-}
-
-// Arvo 1995, sec. 2, as the paper states it, in 50 digits.
-dvec3 arvo_reference(const dvec3& o, const dvec3& p0, const dvec3& p1, const dvec3& p2, double u1, double u2) {
-  const v3 oo = to_mp(o);
-  const v3 A = unit(to_mp(p0) - oo), B = unit(to_mp(p1) - oo), C = unit(to_mp(p2) - oo);
-  const auto angle = [](const v3& x, const v3& y, const v3& z) {
-    const v3 n1 = cross(x, y), n2 = cross(x, z);
-    return mp(atan2(norm(cross(n1, n2)), dot(n1, n2)));
-  };
-  const mp alpha = angle(A, B, C), beta = angle(B, C, A), gamma = angle(C, A, B);
-  const mp area = alpha + beta + gamma - boost::math::constants::pi<mp>();
-  const mp sub = u1 * area;
-  const mp s = sin(sub - alpha), t = cos(sub - alpha);
-  const mp u = t - cos(alpha), v = s + sin(alpha) * dot(A, B);
-  const mp q = ((v * t - u * s) * cos(alpha) - v) / ((v * s + u * t) * sin(alpha));
-  const v3 Cs = q * A + sqrt(1 - q * q) * unit(C - dot(C, A) * A);
-  const mp z = 1 - u2 * (1 - dot(Cs, B));
-  return to_d(z * B + sqrt(1 - z * z) * unit(Cs - dot(Cs, B) * B));
-}
+using test::arvo_reference;
+using test::reference_solid_angle;
 
 double angle_between(const dvec3& a, const dvec3& b) {
   return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
