@@ -22,7 +22,7 @@ namespace {
 
 struct many {
   std::shared_ptr<mcrt::triangle_mesh> mesh = std::make_shared<mcrt::triangle_mesh>();
-  std::vector<mcrt::light> lights;
+  mcrt::light_list lights;
   std::vector<mcrt::emitter> emitters;
   std::vector<mcrt::light_bounds> items;
   mcrt::light_bvh tree;

@@ -72,7 +72,7 @@ struct light_draw {
 
 // side x side stratified samples of light l (side = floor(sqrt(samples))),
 // radiance its luminance.
-std::vector<light_draw> light_draws(const light& l, double radiance, const vec3& o, const vec3& n, int samples,
+std::vector<light_draw> light_draws(light_ref l, double radiance, const vec3& o, const vec3& n, int samples,
                                     pcg32& rng) {
   const int side = std::max(1, static_cast<int>(std::sqrt(double(samples))));
   std::vector<light_draw> out;

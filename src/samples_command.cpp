@@ -58,7 +58,7 @@ int run_samples(const samples_options& opt) {
     for (const std::uint32_t e : sides)
       if (faces(ls.world.lights[ls.world.emitters[e].light], o)) entry = e;
   }
-  const light& l = ls.world.lights[ls.world.emitters[entry].light];
+  const light_ref l = ls.world.lights[ls.world.emitters[entry].light];
 
   std::string csv = "u1,u2,dx,dy,dz,px,py,pz,pdf\n";
   csv.reserve(static_cast<std::size_t>(opt.n) * 96);

@@ -327,7 +327,7 @@ void read_object(const reader& rd, const json& o, const std::string& path, scene
       // Where its choice does not pay for its own cost at the pilot's
       // receivers, the light takes its cheapest strategy's sampler, with no
       // choice per light sample (auto_sampler::table_gain).
-      if (!auto_receivers.empty() && use_cheapest_where_choice_does_not_pay(world.lights.back(), auto_receivers))
+      if (!auto_receivers.empty() && use_cheapest_where_choice_does_not_pay(world.lights, world.lights.size() - 1, auto_receivers))
         out.auto_cheapest_lights.push_back(static_cast<std::uint32_t>(world.lights.size() - 1));
       out.auto_setup_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       return;

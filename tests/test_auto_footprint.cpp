@@ -174,7 +174,7 @@ TEST(AutoFootprint, FloorRadianceUnbiased) {
   p.image_variance = 1e-4f;
   p.radiance = emit;
   sc.add_light(rect_auto_sampler(lr, p), 1);
-  const rect_auto_sampler& s = std::get<rect_auto_sampler>(sc.lights[0]);
+  const rect_auto_sampler& s = sc.lights.get<rect_auto_sampler>(0);
   const std::vector<glm::dvec3> poly{{-0.3, h, -0.2}, {0.3, h, -0.2}, {0.3, h, 0.2}, {-0.3, h, 0.2}};
   const path_settings set{1, 3};
   constexpr int replicates = 32, samples = 1024;

@@ -273,7 +273,7 @@ struct settle_floor {
   // The scene with its light sampled by `auto` with params p.
   scene with_auto(const auto_params& p) const {
     scene sc = pilot_scene;
-    sc.lights[0] = rect_auto_sampler(r, p);
+    sc.lights.set(0, rect_auto_sampler(r, p));
     return sc;
   }
 };
@@ -311,12 +311,12 @@ TEST(ChoiceGainPilot, SettleWeighsEachAutoLight) {
     EXPECT_GE(a[0].noise_share, 0.0);
     EXPECT_LE(a[0].noise_share, 1.0);
     const double v = noise.image_variance;
-    const rect_auto_sampler& s = std::get<rect_auto_sampler>(sc.lights[0]);
+    const rect_auto_sampler& s = sc.lights.get<rect_auto_sampler>(0);
     const rect_auto_sampler at_v = s.with_params(p);
     const std::vector<auto_choice> models = at_v.receiver_models(noise.receivers);
     scene apart = f.with_auto(p);
     const noise_pilot_result low = low_variance_pilot(apart, f.cam, rs);
-    EXPECT_EQ(std::get<rect_auto_sampler>(apart.lights[0]).params.image_variance, p.image_variance)
+    EXPECT_EQ(apart.lights.get<rect_auto_sampler>(0).params.image_variance, p.image_variance)
         << "the lights as they were";
     const double floor = v * at_v.mis_floor(models);
     EXPECT_EQ(low.edge_variance, 0.0) << "the reflected part alone";
@@ -384,7 +384,7 @@ struct sliver_floor {
   // The scene with its light sampled by `auto` with params p.
   scene with_auto(const auto_params& p) const {
     scene sc = pilot_scene;
-    sc.lights[0] = triangle_auto_sampler(t, p);
+    sc.lights.set(0, triangle_auto_sampler(t, p));
     return sc;
   }
 };
@@ -410,7 +410,7 @@ TEST(ChoiceGainPilot, FixedPointTakesTheChoiceAsAWhole) {
   const std::vector<auto_light_settlement> a = settle_auto_lights(sc, cam, rs, noise, 64);
   ASSERT_EQ(a.size(), 1u);
   ASSERT_FALSE(a[0].cheapest);
-  const triangle_auto_sampler before(t, p), after = std::get<triangle_auto_sampler>(sc.lights[0]);
+  const triangle_auto_sampler before(t, p), after = sc.lights.get<triangle_auto_sampler>(0);
   int under = 0, dearer_before = 0, dearer_after = 0;
   for (const auto_receiver& r : noise.receivers) {
     if (!(std::abs(r.p.x) < 4.0f && std::abs(r.p.z) < 1.0f)) continue;
@@ -450,7 +450,7 @@ TEST(ChoiceGainPilot, RestUnderASliverIsTheLowVariancePilots) {
     ASSERT_FALSE(a[0].cheapest);
     const double v = noise.image_variance;
     largest_old_rest = std::max(largest_old_rest, 1.0 - a[0].noise_share);
-    const triangle_auto_sampler after = std::get<triangle_auto_sampler>(sc.lights[0]);
+    const triangle_auto_sampler after = sc.lights.get<triangle_auto_sampler>(0);
     int under = 0, dearer = 0;
     for (const auto_receiver& r : noise.receivers) {
       if (!(std::abs(r.p.x) < 40.0f && std::abs(r.p.z) < 1.0f)) continue;

@@ -55,7 +55,7 @@ TEST(MisWeights, SumToOneForRandomConfigurations) {
   pcg32 rng(2024, 5);
   int checked = 0;
   for (int config = 0; config < 20000; ++config) {
-    std::vector<light> lights;
+    light_list lights;
     std::vector<emitter> emitters;
     const int count = 1 + static_cast<int>(rng.uniform() * 3.0f);
     for (int i = 0; i < count; ++i) {
@@ -110,7 +110,7 @@ TEST(MisWeights, HeuristicsAreTheirFormulas) {
 // (flux) or uniformly, among the emitters that face the point only.
 // Chi-square goodness of fit, 3 degrees of freedom, 1e-4 significance.
 TEST(LightSelection, ChoosesWithTheStatedProbabilities) {
-  std::vector<light> lights;
+  light_list lights;
   std::vector<emitter> emitters;
   for (int i = 0; i < 5; ++i) {
     const rect r = xz_rect(-1.0f + 0.4f * i, -0.8f + 0.4f * i, -0.1f, 0.1f, 2.0f, /*flip=*/i != 2);  // light 2 faces up
@@ -174,7 +174,7 @@ TEST(LightSelection, OneEmitterIsTheGeneralWalk) {
   pcg32 rng(31, 3);
   int compared = 0;
   for (int config = 0; config < 20000; ++config) {
-    std::vector<light> lights{random_light(rng, static_cast<int>(rng.uniform() * 6.0f)),
+    light_list lights{random_light(rng, static_cast<int>(rng.uniform() * 6.0f)),
                               rect_area_sampler{xz_rect(-1.0f, 1.0f, -1.0f, 1.0f, -3.0f, true)}};  // faces down, below o
     const std::vector<emitter> one{{0, 0.1f + rng.uniform()}};
     const std::vector<emitter> two{one[0], {1, 0.1f + rng.uniform()}};
@@ -208,7 +208,7 @@ TEST(LightSelection, OneEmitterIsTheGeneralWalk) {
 // or given a probability, the probabilities sum to 1, and what pick()
 // returns is what probability() says.
 TEST(LightSelection, FacingBeyondTheKeptMask) {
-  std::vector<light> lights;
+  light_list lights;
   std::vector<emitter> emitters;
   for (int i = 0; i < 70; ++i) {
     const float x = -3.5f + 0.1f * static_cast<float>(i);

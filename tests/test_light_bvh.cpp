@@ -27,7 +27,7 @@ namespace {
 // way, with powers over four decades; strategies of every kind.
 struct light_set {
   std::shared_ptr<triangle_mesh> mesh = std::make_shared<triangle_mesh>();
-  std::vector<light> lights;
+  light_list lights;
   std::vector<emitter> emitters;
   light_bvh tree;
 };
@@ -183,7 +183,7 @@ TEST(LightImportance, PositiveWhereTheLightFacesThePoint) {
   int facing = 0;
   for (int i = 0; i < 200000; ++i) {
     const std::size_t k = static_cast<std::size_t>(rng.uniform() * 400.0f) % 400;
-    const light& l = s.lights[k];
+    const light_ref l = s.lights[k];
     const vec3 o{6.0f * (rng.uniform() - 0.5f), 3.0f * rng.uniform() - 0.5f, 6.0f * (rng.uniform() - 0.5f)};
     const vec3 n = random_unit(rng);
     const light_bounds b = bounds_of(l, s.emitters[k].power);
@@ -205,22 +205,21 @@ TEST(LightImportance, ExactIsPiLTimesTheProjectedSolidAngle) {
   int checked = 0;
   for (int i = 0; i < 30000; ++i) {
     const std::size_t k = static_cast<std::size_t>(rng.uniform() * 300.0f) % 300;
-    const light& l = s.lights[k];
+    const light_ref l = s.lights[k];
     const vec3 o{6.0f * (rng.uniform() - 0.5f), 3.0f * rng.uniform() - 0.5f, 6.0f * (rng.uniform() - 0.5f)};
     const vec3 n = random_unit(rng);
     const double piL = double(s.emitters[k].power) / double(surface_area(l));
     const double x = exact_importance(l, s.emitters[k].power, o, n, false);
     std::vector<glm::dvec3> poly;
-    std::visit(
-        [&](const auto& st) {
+    dispatch(
+        l, [&](const auto& st) {
           using Shape = std::decay_t<decltype(st.shape)>;
           if constexpr (std::is_same_v<Shape, triangle>)
             for (int v = 0; v < 3; ++v) poly.push_back(glm::dvec3(st.shape.vertex(v)));
           else if constexpr (std::is_same_v<Shape, rect>)
             poly = {glm::dvec3(st.shape.corner), glm::dvec3(st.shape.corner + st.shape.e1),
                     glm::dvec3(st.shape.corner + st.shape.e1 + st.shape.e2), glm::dvec3(st.shape.corner + st.shape.e2)};
-        },
-        l);
+        });
     if (poly.empty()) continue;
     if (!faces(l, o)) {
       EXPECT_EQ(x, 0.0);

@@ -41,8 +41,8 @@ class Mixture : public testing::TestWithParam<mixture_case> {};
 TEST_P(Mixture, GeneratedDirectionsFollowValueWhichIntegratesToOne) {
   const mixture_case& c = GetParam();
   const cosine_pdf cos(c.n);
-  const light_pdf<light> lights(c.lights, c.p, c.n);
-  const mixture_pdf<light> mix(cos, lights);
+  const light_pdf lights(c.lights, c.p, c.n);
+  const mixture_pdf mix(cos, lights);
   auto sample = [&](pcg32& rng, vec3& dir) {
     float p;
     const float u_select = rng.uniform();
@@ -68,12 +68,12 @@ INSTANTIATE_TEST_SUITE_P(Cases, Mixture, testing::ValuesIn(cases()), [](const au
 TEST(Mixture, LightsThatFaceAwayAreLeftOut) {
   const rect r = xz_rect(0, 1, 0, 1, 2, true);  // emits downwards
   const std::vector<light> ls{rect_area_sampler{r}};
-  EXPECT_FALSE(light_pdf<light>(ls, {0.5f, 0.0f, 0.5f}, {0.0f, 1.0f, 0.0f}).empty());
-  EXPECT_TRUE(light_pdf<light>(ls, {0.5f, 3.0f, 0.5f}, {0.0f, 1.0f, 0.0f}).empty());
+  EXPECT_FALSE(light_pdf(ls, {0.5f, 0.0f, 0.5f}, {0.0f, 1.0f, 0.0f}).empty());
+  EXPECT_TRUE(light_pdf(ls, {0.5f, 3.0f, 0.5f}, {0.0f, 1.0f, 0.0f}).empty());
   // With no light, the mixture is the cosine pdf itself.
   const cosine_pdf cos({0, 1, 0});
-  const light_pdf<light> none(ls, {0.5f, 3.0f, 0.5f}, {0.0f, 1.0f, 0.0f});
-  const mixture_pdf<light> mix(cos, none);
+  const light_pdf none(ls, {0.5f, 3.0f, 0.5f}, {0.0f, 1.0f, 0.0f});
+  const mixture_pdf mix(cos, none);
   for (const vec3 d : {vec3(0, 1, 0), glm::normalize(vec3(1, 1, 0)), vec3(0, -1, 0)})
     EXPECT_FLOAT_EQ(mix.value(d), cos.value(d));
 }

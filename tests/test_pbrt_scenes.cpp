@@ -278,7 +278,7 @@ TEST_P(PbrtTriangleStrategies, MatchLambertOneAndTwoSided) {
   int id = 300;
   for (const std::string& text : {floor_scene(with(nested_triangle, "")), two}) {
     const pbrt::built_scene b = from_text(text, "", st);
-    for (const light& l : b.world.lights) EXPECT_EQ(strategy_of(l), st);
+    for (const light_ref l : b.world.lights) EXPECT_EQ(strategy_of(l), st);
     const std::vector<glm::dvec3> poly = light_triangles(b.world).at(0);
     for (const auto& [x, z] : floor_points)
       check(floor_radiance(b.world, ik, x, z, id++), polygon_floor(poly, x, z), std::string(to_string(st)));
@@ -310,7 +310,7 @@ TEST(PbrtTriangleStrategies, PbrtsAreaBranchBelowItsThreshold) {
   for (const bool tiny : {true, false}) {
     const pbrt::built_scene b = from_text(tiny ? small : floor_scene(with(nested_triangle, "")), "", light_sampling::pbrt);
     ASSERT_EQ(b.world.lights.size(), 1u);
-    const auto& l = std::get<triangle_pbrt_sampler>(b.world.lights[0]);
+    const auto& l = b.world.lights.get<triangle_pbrt_sampler>(0);
     const std::vector<glm::dvec3> poly = light_triangles(b.world).at(0);
     int id = 400 + 10 * tiny;
     for (const auto& [x, z] : floor_points) {
@@ -390,7 +390,7 @@ TEST(PbrtManyLights, EverySelectionMatchesTheSumOfLambert) {
       double exact = 0.0, faced = 0.0;
       for (std::size_t k = 0; k < b.world.lights.size(); ++k) {
         if (!faces(b.world.lights[k], o)) continue;
-        const auto& t = std::get<triangle_area_sampler>(b.world.lights[k]).shape;
+        const auto& t = b.world.lights.get<triangle_area_sampler>(k).shape;
         const std::vector<glm::dvec3> poly{glm::dvec3(t.vertex(0)), glm::dvec3(t.vertex(1)), glm::dvec3(t.vertex(2))};
         const double L = std::get<diffuse_light>(b.world.materials[std::get<std::vector<object<triangle>>>(
                                                                          b.world.objects)[2 + k].material]).emit.r;

@@ -33,6 +33,7 @@
 #include "mcrt/render/camera.hpp"
 #include "mcrt/render/image.hpp"
 #include "mcrt/render/light.hpp"
+#include "mcrt/render/light_list.hpp"
 #include "mcrt/render/light_selection.hpp"
 #include "mcrt/render/mis.hpp"
 #include "mcrt/render/mis_integrator.hpp"

@@ -196,25 +196,24 @@ noise_pilot_result low_variance_pilot(Scene& sc, const camera& cam, const render
   // The auto lights moved out (no copies: many lights are many shared
   // tables' reference counts), their projected samplers in their place.
   std::vector<std::pair<std::size_t, light>> kept;
-  kept.reserve(static_cast<std::size_t>(std::count_if(sc.lights.begin(), sc.lights.end(), [](const light& l) {
+  kept.reserve(static_cast<std::size_t>(std::count_if(sc.lights.begin(), sc.lights.end(), [](light_ref l) {
     return strategy_of(l) == light_sampling::automatic;
   })));
   for (std::size_t i = 0; i < sc.lights.size(); ++i) {
     std::optional<light> projected;
-    std::visit(
-        [&]<class S>(const S& s) {
-          if constexpr (strategy_of<S>() == light_sampling::automatic) projected = s.projected;
-        },
-        sc.lights[i]);
+    dispatch(sc.lights[i], [&]<class S>(const S& s) {
+      if constexpr (strategy_of<S>() == light_sampling::automatic) projected = s.projected;
+    });
     if (!projected) continue;
-    kept.emplace_back(i, std::move(sc.lights[i]));
-    sc.lights[i] = std::move(*projected);
+    kept.emplace_back(i, sc.lights.take(i));
+    sc.lights.set(i, std::move(*projected));
   }
   noise_pilot_settings ps = noise_pilot_for(rs.width, rs.height, rs.spp);
   ps.reflected_only = true;
   ps.light_noise_limit = 0;  // the lights' own noise is not taken out (header)
   noise_pilot_result r = estimate_image_variance(sc, cam, rs, ps);
-  for (auto& [i, l] : kept) sc.lights[i] = std::move(l);
+  for (auto& [i, l] : kept) sc.lights.set(i, std::move(l));
+  sc.lights.compact();
   return r;
 }
 
@@ -268,8 +267,8 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
   // The screen.
   const auto_receiver_groups receiver_groups(noise.receivers);
   for (std::size_t i = 0; i < sc.lights.size(); ++i) {
-    const bool screened = std::visit(
-        [&]<class S>(const S& s) {
+    const bool screened = dispatch(
+        sc.lights[i], [&]<class S>(const S& s) {
           if constexpr (strategy_of<S>() == light_sampling::automatic) {
             const auto_params p = with_rest_cost(s);
             if (!s.cheapest_at_every(receiver_groups, p)) return false;
@@ -279,9 +278,8 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
             return true;
           }
           return false;
-        },
-        sc.lights[i]);
-    if (screened) found[i]->cheapest = use_cheapest(sc.lights[i]);
+        });
+    if (screened) found[i]->cheapest = use_cheapest(sc.lights, i);
   }
   for (std::size_t i = 0; i < sc.lights.size(); ++i) {
     if (found[i]) continue;
@@ -292,8 +290,8 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
     std::vector<auto_choice> models;
     auto_light_settlement a;
     a.light = i;
-    std::visit(
-        [&]<class S>(const S& s) {
+    dispatch(
+        sc.lights[i], [&]<class S>(const S& s) {
           if constexpr (strategy_of<S>() == light_sampling::automatic) {
             auto_params p = with_rest_cost(s);
             a.rest_cost = p.rest_cost;
@@ -379,8 +377,7 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
             a.rest_cost = p.rest_cost;
             rebuilt = s.with_params(p);
           }
-        },
-        sc.lights[i]);
+        });
     if (need_low) {
       // The low-variance pilot, then this light again.
       const auto start = std::chrono::steady_clock::now();
@@ -390,10 +387,11 @@ std::vector<auto_light_settlement> settle_auto_lights(Scene& sc, const camera& c
       continue;
     }
     if (!rebuilt) continue;
-    sc.lights[i] = std::move(*rebuilt);
-    a.cheapest = use_cheapest_where_choice_does_not_pay(sc.lights[i], noise.receivers, models);
+    sc.lights.set(i, std::move(*rebuilt));
+    a.cheapest = use_cheapest_where_choice_does_not_pay(sc.lights, i, noise.receivers, models);
     found[i] = a;
   }
+  sc.lights.compact();  // the holes the lights' new strategies left
   std::vector<auto_light_settlement> out;
   for (const auto& a : found)
     if (a) out.push_back(*a);

@@ -1,7 +1,8 @@
 #pragma once
-// The lights of a scene: every shape that is sampled directly, each with its
-// sampling strategy, in one std::variant so a scene holds exactly the
-// strategies it uses and dispatch is a few compares, not a virtual call.
+// A light: a shape that is sampled directly, with its sampling strategy, as
+// one std::variant whose dispatch is a few compares, not a virtual call. A
+// scene keeps its lights by strategy (render/light_list.hpp), so that each
+// takes its own strategy's bytes and not the variant's.
 #include <concepts>
 #include <optional>
 #include <span>

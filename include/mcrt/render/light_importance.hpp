@@ -30,11 +30,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <concepts>
 #include <type_traits>
 
 #include "mcrt/accel/light_bvh.hpp"
 #include "mcrt/core/fast_math.hpp"
 #include "mcrt/render/light.hpp"
+#include "mcrt/render/light_list.hpp"
 
 namespace mcrt {
 
@@ -150,7 +152,10 @@ inline double projected_solid_angle_of(const S& s, const vec3& o, const vec3& n)
 // The bounds of one light as the hierarchy keeps them: its shape's box, its
 // emitting normal (the side faces() accepts; every direction for a sphere),
 // lambertian emission (theta_e = pi/2) and the flux phi.
-inline light_bounds bounds_of(const light& l, float phi) {
+// L: a `light`, or a light_ref into a scene's light_list.
+template <class L>
+  requires std::same_as<L, light> || std::same_as<L, light_ref>
+light_bounds bounds_of(const L& l, float phi) {
   return dispatch(l, [&](const auto& s) {
     using Shape = std::decay_t<decltype(s.shape)>;
     light_bounds b;
@@ -187,7 +192,9 @@ inline light_bounds bounds_of(const light& l, float phi) {
 // (or of |cos| where both_sides) over the directions it covers; 0 where it
 // does not face o. Negative where the light's shape has no closed form here
 // (disks), for the caller to take bounds_importance instead.
-inline double exact_importance(const light& l, float phi, const vec3& o, const vec3& n, bool both_sides) {
+template <class L>
+  requires std::same_as<L, light> || std::same_as<L, light_ref>
+double exact_importance(const L& l, float phi, const vec3& o, const vec3& n, bool both_sides) {
   return dispatch(l, [&](const auto& s) -> double {
     if (!s.faces(o)) return 0.0;
     double omega = light_importance_detail::projected_solid_angle_of(s, o, n);

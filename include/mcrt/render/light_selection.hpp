@@ -84,9 +84,9 @@ class light_selection {
 #if defined(__GNUC__) || defined(__clang__)
   [[gnu::always_inline]]
 #endif
-  light_selection(std::span<const light> lights, std::span<const emitter> emitters, const light_bvh* tree,
+  light_selection(const light_list& lights, std::span<const emitter> emitters, const light_bvh* tree,
                   const vec3& o, const vec3& n, light_choice how, bool both_sides = false)
-      : lights_(lights), emitters_(emitters), o_(o), n_(n), how_(how), both_sides_(both_sides) {
+      : lights_(&lights), emitters_(emitters), o_(o), n_(n), how_(how), both_sides_(both_sides) {
     const bool hierarchical = how == light_choice::bvh || how == light_choice::pbrt_bvh;
     // One emitter: every choice is P = 1 where it faces the point.
     if (tree && !tree->empty() && emitters.size() > (hierarchical ? 1 : linear_limit)) {
@@ -100,7 +100,7 @@ class light_selection {
     if (hierarchical && emitters.size() > 1)
       throw std::logic_error("light_selection: bvh needs the scene's light tree (scene::build_light_tree)");
     for (std::size_t i = 0; i < emitters_.size(); ++i)
-      if (faces(lights_[emitters_[i].light], o_)) {
+      if (faces((*lights_)[emitters_[i].light], o_)) {
         if (i < mask_bits) facing_ |= std::uint64_t{1} << i;
         ++count_;
         total_ += emitters_[i].power;
@@ -109,7 +109,7 @@ class light_selection {
     // facing lights, there is nothing to choose.
     if (how_ == light_choice::power && !(total_ > 0.0f)) count_ = 0;
   }
-  light_selection(std::span<const light> lights, std::span<const emitter> emitters, const vec3& o, const vec3& n,
+  light_selection(const light_list& lights, std::span<const emitter> emitters, const vec3& o, const vec3& n,
                   light_choice how)
       : light_selection(lights, emitters, nullptr, o, n, how) {}
   // A selection of nothing (empty(), pdf 0 everywhere): a placeholder to
@@ -204,7 +204,7 @@ class light_selection {
     if (count_ == 0) return 0.0f;
     if (count_ == 1 && emitters_.size() == 1) {  // P = 1, as pick
       const std::size_t k = emitters_[0].light;
-      return static_cast<std::ptrdiff_t>(k) == known ? known_pdf : mcrt::pdf(lights_[k], o_, n_, dir, footprint_);
+      return static_cast<std::ptrdiff_t>(k) == known ? known_pdf : mcrt::pdf((*lights_)[k], o_, n_, dir, footprint_);
     }
     float sum = 0.0f;
     for (std::size_t i = 0; i < emitters_.size(); ++i) {
@@ -212,7 +212,7 @@ class light_selection {
       const float p = probability_of(i);
       if (!(p > 0.0f)) continue;
       sum += p * (static_cast<std::ptrdiff_t>(e.light) == known ? known_pdf
-                                                                 : mcrt::pdf(lights_[e.light], o_, n_, dir, footprint_));
+                                                                 : mcrt::pdf((*lights_)[e.light], o_, n_, dir, footprint_));
     }
     return sum;
   }
@@ -224,7 +224,7 @@ class light_selection {
   // the first mask_bits emitters, so pick and pdf do not ask each light again.
   static constexpr std::size_t mask_bits = 64;
   bool facing(std::size_t i) const {
-    return i < mask_bits ? ((facing_ >> i) & 1u) != 0 : faces(lights_[emitters_[i].light], o_);
+    return i < mask_bits ? ((facing_ >> i) & 1u) != 0 : faces((*lights_)[emitters_[i].light], o_);
   }
 
   // P(k) of emitter i (its index in emitters_) without the tree.
@@ -256,7 +256,7 @@ class light_selection {
     const float d2 = glm::dot(v, v);
     if (d2 < 16.0f * s.r2) {
       const emitter& e = item(slot);
-      const double x = exact_importance(lights_[e.light], e.power, o_, n_, both_sides_);
+      const double x = exact_importance((*lights_)[e.light], e.power, o_, n_, both_sides_);
       if (x >= 0.0) return x < double(FLT_MAX) ? float(x) : FLT_MAX;
       light_bounds b;
       b.box = s.box;
@@ -568,7 +568,7 @@ class light_selection {
 
   float light_pdf(std::uint32_t slot, const vec3& dir, std::ptrdiff_t known, float known_pdf) const {
     const std::uint32_t k = item(slot).light;
-    return static_cast<std::ptrdiff_t>(k) == known ? known_pdf : mcrt::pdf(lights_[k], o_, n_, dir, footprint_);
+    return static_cast<std::ptrdiff_t>(k) == known ? known_pdf : mcrt::pdf((*lights_)[k], o_, n_, dir, footprint_);
   }
 
   float pdf_tree(const vec3& dir, std::ptrdiff_t known, float known_pdf) const {
@@ -616,7 +616,7 @@ class light_selection {
     return sum;
   }
 
-  std::span<const light> lights_;
+  const light_list* lights_ = nullptr;
   std::span<const emitter> emitters_;
   const light_bvh* tree_ = nullptr;
   vec3 o_{0.0f}, n_{0.0f, 0.0f, 1.0f};

@@ -47,8 +47,8 @@ struct mixture_integrator {
         const vec3 n = rec.facing_shading_normal(r.d);
         const vec3 origin = rec.spawn_origin(n);  // the sampled directions leave on the facing side
         const cosine_pdf cos_pdf(n);
-        const light_pdf<light> lights(sc.lights, origin, n);
-        const mixture_pdf<light> mix(cos_pdf, lights);
+        const light_pdf lights(sc.lights, origin, n);
+        const mixture_pdf mix(cos_pdf, lights);
         const float u_select = ps.get1d(b + layout::light_choice);
         const bool from_cosine = lights.empty() || u_select < 0.5f;
         const vec2 u = ps.get2d(b + (from_cosine ? layout::material : layout::light));
@@ -73,7 +73,7 @@ struct mixture_integrator {
         const vec3 n = wo.z < 0.0f ? -fr.z : fr.z;
         // From the point moved off the surface to the side the ray came from
         // (as nee_integrator.hpp's light selection).
-        const light_pdf<light> lights(sc.lights, rec.spawn_origin(-r.d), n);
+        const light_pdf lights(sc.lights, rec.spawn_origin(-r.d), n);
         const float u_select = ps.get1d(b + layout::light_choice);
         vec3 wi_local;
         color f;

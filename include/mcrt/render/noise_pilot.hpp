@@ -229,7 +229,7 @@ std::vector<std::uint8_t> emitter_footprint(const Scene& sc, const camera& cam, 
   std::vector<std::uint8_t> mask(static_cast<std::size_t>(width) * height, 0);
   for (const emitter& em : sc.emitters) {
     const std::vector<vec3> pts =
-        std::visit([](const auto& l) { return hull_points(l.shape); }, sc.lights[em.light]);
+        dispatch(sc.lights[em.light], [](const auto& l) { return hull_points(l.shape); });
     float s0 = infinity, s1 = -infinity, t0 = infinity, t1 = -infinity;
     bool front = true;
     for (const vec3& p : pts) {

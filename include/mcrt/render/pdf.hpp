@@ -29,15 +29,17 @@ class cosine_pdf {
 // density is the average of their densities; lights that face away from o
 // take no part, so the mixture stays normalised.
 //
-// Light is any type with faces/sample/pdf (see sampling/light_sample.hpp),
-// or a std::variant of such types through the dispatch in light.hpp.
-template <class Light>
+// Lights is a container (size(), operator[]) of lights: of types with
+// faces/sample/pdf (see sampling/light_sample.hpp), of std::variants of
+// them through the dispatch in light.hpp, or a scene's light_list. It is
+// held by reference and must outlive the light_pdf.
+template <class Lights>
 class light_pdf {
  public:
   // o: the point; n: the unit normal of its surface, for the strategies
   // that weigh by the cosine there.
-  light_pdf(std::span<const Light> lights, const vec3& o, const vec3& n) : lights_(lights), o_(o), n_(n) {
-    for (const Light& l : lights_) count_ += faces(l, o_) ? 1 : 0;
+  light_pdf(const Lights& lights, const vec3& o, const vec3& n) : lights_(lights), o_(o), n_(n) {
+    for (std::size_t i = 0; i < lights_.size(); ++i) count_ += faces(lights_[i], o_) ? 1 : 0;
   }
 
   bool empty() const { return count_ == 0; }
@@ -67,7 +69,7 @@ class light_pdf {
   }
 
  private:
-  std::span<const Light> lights_;
+  const Lights& lights_;
   vec3 o_, n_;
   std::size_t count_ = 0;
 };
@@ -75,10 +77,10 @@ class light_pdf {
 // Shirley's mixture_pdf with equal weights, as in the book and the thesis:
 // half the directions from the lights, half from the cosine pdf. Where no
 // light faces the point, the cosine pdf alone.
-template <class Light>
+template <class Lights>
 class mixture_pdf {
  public:
-  mixture_pdf(const cosine_pdf& cos, const light_pdf<Light>& lights) : cos_(cos), lights_(lights) {}
+  mixture_pdf(const cosine_pdf& cos, const light_pdf<Lights>& lights) : cos_(cos), lights_(lights) {}
 
   // Density per unit SOLID ANGLE of the unit direction dir.
   float value(const vec3& dir) const {
@@ -110,7 +112,7 @@ class mixture_pdf {
 
  private:
   const cosine_pdf& cos_;
-  const light_pdf<Light>& lights_;
+  const light_pdf<Lights>& lights_;
 };
 
 }  // namespace mcrt

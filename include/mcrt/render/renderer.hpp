@@ -195,7 +195,7 @@ render_result render_with(const Scene& sc, const camera& cam, const render_setti
   const Sampler sampler(rs.seed, rs.spp);
   // A scene with lights `auto` samples: one choice per pixel at the camera
   // rays' first surfaces (sampling/auto_footprint.hpp).
-  const bool footprint = std::any_of(sc.lights.begin(), sc.lights.end(), [](const light& l) {
+  const bool footprint = std::any_of(sc.lights.begin(), sc.lights.end(), [](light_ref l) {
     return strategy_of(l) == light_sampling::automatic;
   });
   constexpr int tile = 16;

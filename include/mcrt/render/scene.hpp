@@ -25,6 +25,7 @@
 #include "mcrt/materials/material.hpp"
 #include "mcrt/render/light.hpp"
 #include "mcrt/render/light_importance.hpp"
+#include "mcrt/render/light_list.hpp"
 
 namespace mcrt {
 
@@ -52,7 +53,7 @@ struct basic_scene {
   // Every directly sampled shape with its strategy (Shirley's list of
   // "lights": the emitters and the non-emitting importance targets such as
   // book 3's glass sphere), as the mixture pdf samples them.
-  std::vector<light> lights;
+  light_list lights;
   // The lights that emit, for the next-event estimators (nee, mis).
   std::vector<emitter> emitters;
   // The hierarchy over the emitters (item i: emitters[i]) by which
@@ -162,8 +163,11 @@ struct basic_scene {
 
   // Builds the light hierarchy over the emitters (render/light_selection.hpp
   // uses it for bvh, and for power and uniform past a few emitters). Lights
-  // added later are not in it until it is called again.
+  // added later are not in it until it is called again. The loaders call it
+  // once every light is added, so the lights' arrays are trimmed here to
+  // the lights they hold (a vector's growth leaves up to half again).
   void build_light_tree() {
+    lights.shrink_to_fit();
     std::vector<light_bounds> items;
     items.reserve(emitters.size());
     for (const emitter& e : emitters) items.push_back(bounds_of(lights[e.light], e.power));
