@@ -46,6 +46,14 @@ using light = std::variant<rect_area_sampler, rect_solid_angle_sampler, ellipse_
                            triangle_bilinear_solid_angle_sampler, triangle_pbrt_sampler, rect_pbrt_sampler,
                            triangle_auto_sampler>;
 
+// What the functions below take as a light: a `light`, or a light of a
+// scene's light_list (render/light_list.hpp marks its reference so); each
+// reaches the strategy through dispatch().
+template <class L>
+inline constexpr bool is_light_handle = std::is_same_v<L, light>;
+template <class L>
+concept light_handle = is_light_handle<L>;
+
 // The strategy a light-sampling class implements (--stats, mcrt samples).
 template <class S>
 constexpr light_sampling strategy_of() {
@@ -69,44 +77,54 @@ constexpr light_sampling strategy_of() {
   else
     return light_sampling::solid_angle;
 }
-inline light_sampling strategy_of(const light& l) {
+template <light_handle L>
+light_sampling strategy_of(const L& l) {
   return dispatch(l, []<class S>(const S&) { return strategy_of<S>(); });
 }
 
-// A light sampled by `auto` whose choice per shading point does not pay for
-// its own cost at the receivers rs (auto_sampler::table_gain) becomes its
-// cheapest strategy's sampler, with no choice per light sample. Returns
-// whether it did; other lights are left as they are. models: the light's
-// rule's models at rs (auto_sampler::receiver_models), where the caller
-// has them; empty, they are evaluated here.
+// The sampler of the cheapest strategy of a light `auto` samples; nullopt
+// for any other light.
+template <light_handle L>
+std::optional<light> cheapest_sampler(const L& l) {
+  std::optional<light> cheapest;
+  dispatch(l, [&]<class S>(const S& s) {
+    if constexpr (strategy_of<S>() == light_sampling::automatic) {
+      if (s.cheapest() == light_sampling::area)
+        cheapest = s.area;
+      else
+        cheapest = s.solid_angle;
+    }
+  });
+  return cheapest;
+}
+// Whether a light `auto` samples gains from its choice per shading point at
+// the receivers rs, beyond the choice's own cost (auto_sampler::table_gain);
+// true for any other light. models: the light's rule's models at rs
+// (auto_sampler::receiver_models), where the caller has them; empty, they
+// are evaluated here.
+template <light_handle L>
+bool choice_pays(const L& l, std::span<const auto_receiver> rs, std::span<const auto_choice> models = {}) {
+  bool pays = true;
+  dispatch(l, [&]<class S>(const S& s) {
+    if constexpr (strategy_of<S>() == light_sampling::automatic)
+      pays = (models.empty() ? s.table_gain(rs) : s.table_gain(rs, models)) > 0.0f;
+  });
+  return pays;
+}
+
 // A light sampled by `auto` made its cheapest strategy's sampler (other
 // lights are left as they are); returns whether it was.
 inline bool use_cheapest(light& l) {
-  std::optional<light> cheapest;
-  std::visit(
-      [&]<class S>(const S& s) {
-        if constexpr (strategy_of<S>() == light_sampling::automatic) {
-          if (s.cheapest() == light_sampling::area)
-            cheapest = s.area;
-          else
-            cheapest = s.solid_angle;
-        }
-      },
-      l);
+  std::optional<light> cheapest = cheapest_sampler(l);
   if (!cheapest) return false;
   l = std::move(*cheapest);
   return true;
 }
+// The same where its choice does not pay at rs (choice_pays), with no choice
+// per light sample from then on.
 inline bool use_cheapest_where_choice_does_not_pay(light& l, std::span<const auto_receiver> rs,
                                                    std::span<const auto_choice> models = {}) {
-  bool pays = true;
-  std::visit(
-      [&]<class S>(const S& s) {
-        if constexpr (strategy_of<S>() == light_sampling::automatic)
-          pays = (models.empty() ? s.table_gain(rs) : s.table_gain(rs, models)) > 0.0f;
-      },
-      l);
-  return !pays && use_cheapest(l);
+  return !choice_pays(l, rs, models) && use_cheapest(l);
 }
 
 // The free functions light_pdf (render/pdf.hpp) and the integrators call:
@@ -141,13 +159,16 @@ float pdf(const S& s, const vec3& o, const vec3& n, const vec3& dir) {
     return s.pdf(o, dir);
 }
 
-inline bool faces(const light& l, const vec3& o) {
+template <light_handle L>
+bool faces(const L& l, const vec3& o) {
   return dispatch(l, [&](const auto& s) { return s.faces(o); });
 }
-inline bool sample(const light& l, const vec3& o, const vec3& n, vec2 u, light_sample& out) {
+template <light_handle L>
+bool sample(const L& l, const vec3& o, const vec3& n, vec2 u, light_sample& out) {
   return dispatch(l, [&](const auto& s) { return mcrt::sample(s, o, n, u, out); });
 }
-inline float pdf(const light& l, const vec3& o, const vec3& n, const vec3& dir) {
+template <light_handle L>
+float pdf(const L& l, const vec3& o, const vec3& n, const vec3& dir) {
   return dispatch(l, [&](const auto& s) { return mcrt::pdf(s, o, n, dir); });
 }
 
@@ -155,8 +176,8 @@ inline float pdf(const light& l, const vec3& o, const vec3& n, const vec3& dir) 
 // The same at a camera ray's first surface, where the lights `auto`
 // samples take one choice over the pixel's footprint fp (nullptr: none;
 // sampling/auto_footprint.hpp); every other light as above.
-inline bool sample(const light& l, const vec3& o, const vec3& n, vec2 u, light_sample& out,
-                   const auto_footprint* fp) {
+template <light_handle L>
+bool sample(const L& l, const vec3& o, const vec3& n, vec2 u, light_sample& out, const auto_footprint* fp) {
   if (!fp) return sample(l, o, n, u, out);
   return dispatch(l, [&]<class S>(const S& s) {
     if constexpr (strategy_of<S>() == light_sampling::automatic)
@@ -165,7 +186,8 @@ inline bool sample(const light& l, const vec3& o, const vec3& n, vec2 u, light_s
       return mcrt::sample(s, o, n, u, out);
   });
 }
-inline float pdf(const light& l, const vec3& o, const vec3& n, const vec3& dir, const auto_footprint* fp) {
+template <light_handle L>
+float pdf(const L& l, const vec3& o, const vec3& n, const vec3& dir, const auto_footprint* fp) {
   if (!fp) return pdf(l, o, n, dir);
   return dispatch(l, [&]<class S>(const S& s) {
     if constexpr (strategy_of<S>() == light_sampling::automatic)
@@ -179,7 +201,8 @@ inline float surface_area(const rect& r) { return r.area; }
 inline float surface_area(const ellipse& e) { return e.area; }
 inline float surface_area(const sphere& s) { return 2.0f * two_pi * s.radius * s.radius; }
 inline float surface_area(const triangle& t) { return t.area(); }
-inline float surface_area(const light& l) {
+template <light_handle L>
+float surface_area(const L& l) {
   return dispatch(l, [](const auto& s) { return surface_area(s.shape); });
 }
 

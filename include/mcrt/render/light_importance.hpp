@@ -30,13 +30,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <concepts>
 #include <type_traits>
 
 #include "mcrt/accel/light_bvh.hpp"
 #include "mcrt/core/fast_math.hpp"
 #include "mcrt/render/light.hpp"
-#include "mcrt/render/light_list.hpp"
 
 namespace mcrt {
 
@@ -152,9 +150,7 @@ inline double projected_solid_angle_of(const S& s, const vec3& o, const vec3& n)
 // The bounds of one light as the hierarchy keeps them: its shape's box, its
 // emitting normal (the side faces() accepts; every direction for a sphere),
 // lambertian emission (theta_e = pi/2) and the flux phi.
-// L: a `light`, or a light_ref into a scene's light_list.
-template <class L>
-  requires std::same_as<L, light> || std::same_as<L, light_ref>
+template <light_handle L>
 light_bounds bounds_of(const L& l, float phi) {
   return dispatch(l, [&](const auto& s) {
     using Shape = std::decay_t<decltype(s.shape)>;
@@ -192,8 +188,7 @@ light_bounds bounds_of(const L& l, float phi) {
 // (or of |cos| where both_sides) over the directions it covers; 0 where it
 // does not face o. Negative where the light's shape has no closed form here
 // (disks), for the caller to take bounds_importance instead.
-template <class L>
-  requires std::same_as<L, light> || std::same_as<L, light_ref>
+template <light_handle L>
 double exact_importance(const L& l, float phi, const vec3& o, const vec3& n, bool both_sides) {
   return dispatch(l, [&](const auto& s) -> double {
     if (!s.faces(o)) return 0.0;

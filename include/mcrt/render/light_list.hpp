@@ -9,9 +9,9 @@
 // 1/20 the size of the samplers'), then the same chain of compares
 // (core/dispatch.hpp).
 //
-// A light is reached through a light_ref, which the free functions of
-// light.hpp (faces, sample, pdf, strategy_of, surface_area) and
-// light_importance.hpp take as they take a `light`. Changing a light's
+// A light is reached through a light_ref, which the functions of light.hpp
+// (faces, sample, pdf, strategy_of, surface_area) and light_importance.hpp
+// take as they take a `light` (light_handle). Changing a light's
 // strategy (set) leaves a hole in its old array, which compact() reclaims;
 // set, push_back and compact invalidate references into the arrays, as a
 // vector's reallocation does.
@@ -58,10 +58,6 @@ class basic_light_list<std::variant<S...>> {
     decltype(auto) visit(F&& f) const {
       return list_->visit_entry(list_->entries_[k_], static_cast<F&&>(f));
     }
-    // A copy of the light as a `light`.
-    value_type value() const {
-      return visit([](const auto& s) { return value_type(s); });
-    }
 
    private:
     const basic_light_list* list_;
@@ -70,18 +66,16 @@ class basic_light_list<std::variant<S...>> {
 
   class const_iterator {
    public:
-    using iterator_category = std::random_access_iterator_tag;
+    using reference = basic_light_list::reference;  // a light_ref, by value
     using value_type = reference;
+    using iterator_category = std::forward_iterator_tag;
     using difference_type = std::ptrdiff_t;
     using pointer = void;
-    using reference_type = reference;
     const_iterator() = default;
     const_iterator(const basic_light_list* l, std::size_t k) : list_(l), k_(k) {}
     reference operator*() const { return (*list_)[k_]; }
     const_iterator& operator++() { return ++k_, *this; }
     const_iterator operator++(int) { const_iterator t = *this; ++k_; return t; }
-    const_iterator& operator+=(difference_type d) { return k_ = static_cast<std::size_t>(difference_type(k_) + d), *this; }
-    friend difference_type operator-(const_iterator a, const_iterator b) { return difference_type(a.k_) - difference_type(b.k_); }
     friend bool operator==(const const_iterator& a, const const_iterator& b) { return a.k_ == b.k_; }
 
    private:
@@ -259,68 +253,25 @@ class basic_light_list<std::variant<S...>> {
 using light_list = basic_light_list<light>;
 using light_ref = light_list::reference;
 
-// The free functions of light.hpp, for a light of a list.
+// A light of a list goes wherever a `light` does (light.hpp's functions,
+// bounds_of, exact_importance), through this dispatch.
+template <>
+inline constexpr bool is_light_handle<light_ref> = true;
 template <class F>
 decltype(auto) dispatch(light_ref l, F&& f) { return l.visit(static_cast<F&&>(f)); }
-inline light_sampling strategy_of(light_ref l) {
-  return l.visit([]<class S>(const S&) { return strategy_of<S>(); });
-}
-inline bool faces(light_ref l, const vec3& o) {
-  return l.visit([&](const auto& s) { return s.faces(o); });
-}
-inline bool sample(light_ref l, const vec3& o, const vec3& n, vec2 u, light_sample& out) {
-  return l.visit([&](const auto& s) { return mcrt::sample(s, o, n, u, out); });
-}
-inline float pdf(light_ref l, const vec3& o, const vec3& n, const vec3& dir) {
-  return l.visit([&](const auto& s) { return mcrt::pdf(s, o, n, dir); });
-}
-inline bool sample(light_ref l, const vec3& o, const vec3& n, vec2 u, light_sample& out, const auto_footprint* fp) {
-  if (!fp) return sample(l, o, n, u, out);
-  return l.visit([&]<class S>(const S& s) {
-    if constexpr (strategy_of<S>() == light_sampling::automatic)
-      return s.sample(o, n, u, out, fp);
-    else
-      return mcrt::sample(s, o, n, u, out);
-  });
-}
-inline float pdf(light_ref l, const vec3& o, const vec3& n, const vec3& dir, const auto_footprint* fp) {
-  if (!fp) return pdf(l, o, n, dir);
-  return l.visit([&]<class S>(const S& s) {
-    if constexpr (strategy_of<S>() == light_sampling::automatic)
-      return s.pdf(o, n, dir, fp);
-    else
-      return mcrt::pdf(s, o, n, dir);
-  });
-}
-inline float surface_area(light_ref l) {
-  return l.visit([](const auto& s) { return surface_area(s.shape); });
-}
 
 // use_cheapest and use_cheapest_where_choice_does_not_pay (light.hpp) for
 // light k of a list: the light is changed through set(), without a copy of
 // the `auto` sampler.
 inline bool use_cheapest(light_list& ls, std::size_t k) {
-  std::optional<light> cheapest;
-  ls[k].visit([&]<class S>(const S& s) {
-    if constexpr (strategy_of<S>() == light_sampling::automatic) {
-      if (s.cheapest() == light_sampling::area)
-        cheapest = s.area;
-      else
-        cheapest = s.solid_angle;
-    }
-  });
+  std::optional<light> cheapest = cheapest_sampler(ls[k]);
   if (!cheapest) return false;
   ls.set(k, std::move(*cheapest));
   return true;
 }
 inline bool use_cheapest_where_choice_does_not_pay(light_list& ls, std::size_t k, std::span<const auto_receiver> rs,
                                                    std::span<const auto_choice> models = {}) {
-  bool pays = true;
-  ls[k].visit([&]<class S>(const S& s) {
-    if constexpr (strategy_of<S>() == light_sampling::automatic)
-      pays = (models.empty() ? s.table_gain(rs) : s.table_gain(rs, models)) > 0.0f;
-  });
-  return !pays && use_cheapest(ls, k);
+  return !choice_pays(ls[k], rs, models) && use_cheapest(ls, k);
 }
 
 }  // namespace mcrt

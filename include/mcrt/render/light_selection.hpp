@@ -53,6 +53,7 @@
 #include "mcrt/accel/light_bvh.hpp"
 #include "mcrt/render/light.hpp"
 #include "mcrt/render/light_importance.hpp"
+#include "mcrt/render/light_list.hpp"
 #include "mcrt/render/scene.hpp"
 
 namespace mcrt {
