@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "image_input.hpp"
 #include "mcrt/io/ppm.hpp"
 #include "scene_loader.hpp"
 
@@ -37,7 +38,7 @@ float srgb_encode(float v) {
   return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
 }
 
-void commit(const std::string& tmp, const std::string& path) {
+void commit_tmp(const std::string& tmp, const std::string& path) {
   std::error_code ec;
   fs::rename(tmp, path, ec);
   if (ec) {
@@ -63,6 +64,10 @@ void check_writable(const std::string& path, bool needs_image_format) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw input_error(path + ": output directory '" + dir.string() + "' does not exist");
   if (fs::is_directory(p, ec)) throw input_error(path + ": is a directory");
+  // The output replaces its target by a rename: a device, a FIFO or a
+  // socket there (-o /dev/null) would be replaced by a regular file.
+  if (fs::exists(p, ec) && !fs::is_regular_file(p, ec))
+    throw input_error(path + ": is not a regular file (a device, a FIFO or a socket); mcrt writes to files only");
   const std::string tmp = temp_name(path);
   {
     std::ofstream probe(tmp, std::ios::binary);
@@ -84,7 +89,7 @@ void write_image(const std::string& path, const image& img, const std::vector<im
         throw std::runtime_error(path + ": write failed");
       }
     }
-    commit(tmp, path);
+    commit_tmp(tmp, path);
     return;
   }
   auto out = OIIO::ImageOutput::create(fmt == image_format::exr ? "openexr" : "png");
@@ -119,7 +124,7 @@ void write_image(const std::string& path, const image& img, const std::vector<im
     fs::remove(tmp);
     throw std::runtime_error(path + ": write failed: " + err);
   }
-  commit(tmp, path);
+  commit_tmp(tmp, path);
 }
 
 void write_text(const std::string& path, const std::string& text) {
@@ -133,23 +138,40 @@ void write_text(const std::string& path, const std::string& text) {
       throw std::runtime_error(path + ": write failed");
     }
   }
-  commit(tmp, path);
+  commit_tmp(tmp, path);
 }
 
-image read_image(const std::string& path) {
-  if (!fs::is_regular_file(path)) throw input_error(path + ": no such image file");
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw input_error(path + ": cannot read image: " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
-  image img(spec.width, spec.height);
-  std::vector<float> buf(static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height) *
-                         static_cast<std::size_t>(spec.nchannels));
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, buf.data()))
-    throw input_error(path + ": cannot read image: " + in->geterror());
-  const int nc = spec.nchannels;
+output_file::output_file(const std::string& path) : path_(path), tmp_(temp_name(path)), os_(tmp_, std::ios::binary) {
+  if (!os_) throw std::runtime_error(path + ": cannot write");
+}
+
+output_file::~output_file() {
+  if (committed_) return;
+  os_.close();
+  std::error_code ec;
+  fs::remove(tmp_, ec);
+}
+
+void output_file::commit() {
+  os_.flush();
+  const bool ok = static_cast<bool>(os_);
+  os_.close();
+  if (!ok) throw std::runtime_error(path_ + ": write failed");
+  commit_tmp(tmp_, path_);
+  committed_ = true;
+}
+
+image read_image(const std::string& path, std::uint64_t max_bytes) {
+  io::decoded_image in;
+  try {
+    in = io::decode_image_file(path, max_bytes);
+  } catch (const io::input_file_error& e) {
+    throw input_error(path + ": " + e.what());
+  }
+  image img(in.width, in.height);
+  const std::size_t nc = static_cast<std::size_t>(in.channels);
   for (std::size_t i = 0; i < img.pixels.size(); ++i)
-    for (int c = 0; c < 3; ++c) img.pixels[i][c] = buf[i * static_cast<std::size_t>(nc) + static_cast<std::size_t>(std::min(c, nc - 1))];
-  in->close();
+    for (std::size_t c = 0; c < 3; ++c) img.pixels[i][static_cast<int>(c)] = in.px[i * nc + std::min(c, nc - 1)];
   return img;
 }
 

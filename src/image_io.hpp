@@ -3,6 +3,9 @@
 // (8-bit sRGB-encoded) and PPM (8-bit, gamma 2 as in Shirley's books).
 // Writes go to a temporary file beside the target, renamed into place, so
 // an output file is never left half-written.
+#include <cstdint>
+#include <fstream>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -34,8 +37,27 @@ void write_image(const std::string& path, const image& img, const std::vector<im
 // Writes text (e.g. a JSON stats file) atomically.
 void write_text(const std::string& path, const std::string& text);
 
+// A file written piece by piece to a temporary name beside `path` and
+// renamed into place by commit(); destroyed uncommitted (an exception on
+// the way), the temporary is removed and the target never touched.
+class output_file {
+ public:
+  explicit output_file(const std::string& path);
+  ~output_file();
+  output_file(const output_file&) = delete;
+  output_file& operator=(const output_file&) = delete;
+  std::ostream& stream() { return os_; }
+  void commit();
+
+ private:
+  std::string path_, tmp_;
+  std::ofstream os_;
+  bool committed_ = false;
+};
+
 // Reads any image render writes, as float RGB (8-bit formats as their
-// stored 0..1 values). Throws input_error if unreadable.
-image read_image(const std::string& path);
+// stored 0..1 values). Throws input_error if unreadable, not a regular
+// file, or larger than max_bytes (file or decoded pixels: image_input.hpp).
+image read_image(const std::string& path, std::uint64_t max_bytes);
 
 }  // namespace mcrt::cli

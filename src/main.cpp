@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -32,13 +33,41 @@ struct render_options {
   std::optional<unsigned> threads;
   std::optional<float> auto_rest_cost, auto_rest_variance;
   std::uint64_t seed = 0;
+  std::string max_input_size;
   bool quiet = false;
 };
 
 struct diff_options {
-  std::string image, reference;
+  std::string image, reference, max_input_size;
   bool json = false;
 };
+
+// --max-input-size: bytes, or a number with the suffix K, M, G or T
+// (powers of 1024; "1G" is 1073741824 bytes).
+std::uint64_t parse_max_input_size(const std::string& text) {
+  const auto bad = [&] {
+    return input_error("--max-input-size: expected a size in bytes such as 1073741824, 512M or 4G, got '" +
+                       text.substr(0, 80) + "'");
+  };
+  if (text.empty()) throw bad();
+  std::size_t digits = 0;
+  while (digits < text.size() && std::isdigit(static_cast<unsigned char>(text[digits]))) ++digits;
+  if (digits == 0 || digits > 19 || text.size() - digits > 1) throw bad();
+  std::uint64_t shift = 0;
+  if (digits < text.size()) {
+    switch (std::toupper(static_cast<unsigned char>(text.back()))) {
+      case 'K': shift = 10; break;
+      case 'M': shift = 20; break;
+      case 'G': shift = 30; break;
+      case 'T': shift = 40; break;
+      default: throw bad();
+    }
+  }
+  const std::uint64_t v = std::stoull(text.substr(0, digits));
+  if (v == 0) throw input_error("--max-input-size: must be > 0");
+  if (v > (std::numeric_limits<std::uint64_t>::max() >> shift)) throw bad();
+  return v << shift;
+}
 
 void check_range(const std::optional<int>& v, const char* flag, int lo, int hi) {
   if (v && (*v < lo || *v > hi))
@@ -100,7 +129,9 @@ int run_render(const render_options& opt) {
   // pilot measures on the scene with those lights sampled by their cheapest
   // strategy (auto_strategy.hpp, auto_params; render/noise_pilot.hpp).
   const bool pilot = !opt.auto_rest_variance;
-  loaded_scene ls = load_scene(opt.scene, strategy, map, ap, pilot);
+  const std::uint64_t max_input =
+      opt.max_input_size.empty() ? io::default_max_input_bytes : parse_max_input_size(opt.max_input_size);
+  loaded_scene ls = load_scene(opt.scene, strategy, map, ap, pilot, {}, max_input);
   // Without -o: a pbrt-v4 file's Film filename (in the current directory), else SCENE-NAME.exr.
   const std::string output = !opt.output.empty() ? opt.output
                              : !ls.output.empty() ? std::filesystem::path(ls.output).filename().string()
@@ -154,7 +185,7 @@ int run_render(const render_options& opt) {
     // A noise-free pilot leaves nothing for a cheaper strategy to hide in.
     ap.image_variance = std::max(static_cast<float>(noise->image_variance), std::numeric_limits<float>::min());
     ap.albedo = static_cast<float>(std::sqrt(noise->mean_albedo2));
-    ls = load_scene(opt.scene, strategy, map, ap, false);
+    ls = load_scene(opt.scene, strategy, map, ap, false, {}, max_input);
     // Each light's rule at the fixed point of the image's noise and time
     // its choice makes, and the gate of its choice (render/choice_gain_pilot.hpp).
     const auto settle_start = std::chrono::steady_clock::now();
@@ -240,7 +271,9 @@ int run_render(const render_options& opt) {
 }
 
 int run_diff(const diff_options& opt) {
-  const image a = read_image(opt.image), r = read_image(opt.reference);
+  const std::uint64_t max_input =
+      opt.max_input_size.empty() ? io::default_max_input_bytes : parse_max_input_size(opt.max_input_size);
+  const image a = read_image(opt.image, max_input), r = read_image(opt.reference, max_input);
   if (a.width != r.width || a.height != r.height)
     throw input_error("images differ in size: " + opt.image + " is " + std::to_string(a.width) + "x" +
                       std::to_string(a.height) + ", " + opt.reference + " is " + std::to_string(r.width) + "x" +
@@ -323,12 +356,17 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"power", "uniform", "bvh", "pbrt-bvh"}));
   render_cmd->add_option("--stats", ro.stats, "Write render statistics as JSON to this file");
   render_cmd->add_flag("--quiet", ro.quiet, "No progress line");
+  const char* max_input_help =
+      "Read no input file (scene, included file, PLY mesh, image), nor a .gz file's unpacked stream, past this "
+      "size: bytes, or with K, M, G or T (default 1G)";
+  render_cmd->add_option("--max-input-size", ro.max_input_size, max_input_help);
 
   diff_options dop;
   CLI::App* diff_cmd = app.add_subcommand("diff", "Compare an image with a reference");
   diff_cmd->add_option("image", dop.image, "Image")->required();
   diff_cmd->add_option("reference", dop.reference, "Reference image")->required();
   diff_cmd->add_flag("--json", dop.json, "Print one JSON object");
+  diff_cmd->add_option("--max-input-size", dop.max_input_size, max_input_help);
 
   samples_options sop;
   CLI::App* samples_cmd = app.add_subcommand("samples", "Write samples of one light's strategy as CSV");
@@ -343,6 +381,7 @@ int main(int argc, char** argv) {
   samples_cmd->add_option("--n", sop.n, "Number of samples (default 100000)");
   samples_cmd->add_option("--seed", sop.seed, "Random seed (default 0)");
   samples_cmd->add_option("-o,--output", sop.output, "CSV file (default: standard output)");
+  samples_cmd->add_option("--max-input-size", sop.max_input_size, max_input_help);
 
   if (argc > 1 && argv[1][0] != '-' && std::string(argv[1]) != "render" && std::string(argv[1]) != "diff" &&
       std::string(argv[1]) != "samples") {
@@ -365,7 +404,11 @@ int main(int argc, char** argv) {
   }
   try {
     if (render_cmd->parsed()) return run_render(ro);
-    if (samples_cmd->parsed()) return run_samples(sop);
+    if (samples_cmd->parsed()) {
+      sop.max_input_bytes =
+          sop.max_input_size.empty() ? io::default_max_input_bytes : parse_max_input_size(sop.max_input_size);
+      return run_samples(sop);
+    }
     return run_diff(dop);
   } catch (const input_error& e) {
     std::fprintf(stderr, "mcrt: %s\n", e.what());

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "image_io.hpp"
@@ -42,7 +43,7 @@ int run_samples(const samples_options& opt) {
   const std::optional<light_sampling> strategy = parse_light_sampling_flag(opt.light_sampling);
   const ellipse_map map = opt.ellipse_map == "polar" ? ellipse_map::polar : ellipse_map::parallel;
   if (!opt.output.empty()) check_writable(opt.output, false);
-  const loaded_scene ls = load_scene(opt.scene, strategy, map);
+  const loaded_scene ls = load_scene(opt.scene, strategy, map, {}, false, {}, opt.max_input_bytes);
   // A pbrt-v4 file numbers its lights in file order, a two-sided one with
   // an entry per side: the side that faces the point is sampled.
   const bool by_file = !ls.file_lights.empty();
@@ -60,8 +61,14 @@ int run_samples(const samples_options& opt) {
   }
   const light_ref l = ls.world.lights[ls.world.emitters[entry].light];
 
+  // Written a block at a time (10^8 rows take about 9 GB): to standard
+  // output, or to a temporary file renamed into place at the end.
+  std::optional<output_file> file;
+  if (!opt.output.empty()) file.emplace(opt.output);
+  std::ostream& os = file ? file->stream() : std::cout;
   std::string csv = "u1,u2,dx,dy,dz,px,py,pz,pdf\n";
-  csv.reserve(static_cast<std::size_t>(opt.n) * 96);
+  constexpr std::size_t block = std::size_t(1) << 20;
+  csv.reserve(block + 256);
   pcg32 rng(mix64(opt.seed), 0x5a3c1f7d2b9e4861ULL);
   for (long long i = 0; i < opt.n; ++i) {
     const vec2 u = rng.uniform2();
@@ -80,11 +87,13 @@ int run_samples(const samples_options& opt) {
       csv += ",0,0,0,0,0,0,0";  // no sample: pdf 0
     }
     csv += '\n';
+    if (csv.size() >= block) {
+      os << csv;
+      csv.clear();
+    }
   }
-  if (opt.output.empty())
-    std::cout << csv << std::flush;
-  else
-    write_text(opt.output, csv);
+  os << csv << std::flush;
+  if (file) file->commit();
   return 0;
 }
 

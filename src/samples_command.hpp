@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <string>
 
+#include "input_file.hpp"
+
 namespace mcrt::cli {
 
 struct samples_options {
@@ -11,6 +13,8 @@ struct samples_options {
   long long light = -1;
   long long n = 100000;
   std::uint64_t seed = 0;
+  std::string max_input_size;  // --max-input-size as given
+  std::uint64_t max_input_bytes = io::default_max_input_bytes;  // ... as bytes
 };
 
 // Throws input_error (exit status 2) for bad arguments, before writing anything.

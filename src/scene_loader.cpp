@@ -1,10 +1,12 @@
 #include "scene_loader.hpp"
 
+#include "input_file.hpp"
 #include "pbrt/builder.hpp"
 #include "texture_io.hpp"
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -44,34 +46,57 @@ const char* type_name(const json& j) {
 constexpr const char* overflow_marker = "<mcrt: number overflows a double>";
 
 // Parses JSON text; number literals that overflow a double are replaced by
-// overflow_marker, so the reader can name where they are.
+// overflow_marker first (one pass over the text, outside strings), so the
+// reader can name where they are.
 json parse_json(std::string text, const context& ctx) {
-  for (int attempt = 0; attempt < 10000; ++attempt) {
-    try {
-      return json::parse(text);
-    } catch (const json::parse_error& e) {
-      std::string what = e.what();
-      // "[json.exception.parse_error.101] parse error at line 3, column 5: ..." -> keep the readable part.
-      if (const auto p = what.find("parse error"); p != std::string::npos) what = what.substr(p);
-      ctx.fail("", "invalid JSON: " + what);
-    } catch (const json::out_of_range& e) {
-      // "number overflow parsing '1e999'": replace that literal wherever it
-      // stands as a whole number token, then parse again.
-      const std::string what = e.what();
-      const auto a = what.find('\''), b = what.rfind('\'');
-      if (e.id != 406 || a == std::string::npos || b <= a + 1) ctx.fail("", std::string("invalid JSON: ") + e.what());
-      const std::string token = what.substr(a + 1, b - a - 1);
-      const auto is_num = [](char c) { return std::isdigit(static_cast<unsigned char>(c)) || c == '.' || c == 'e' || c == 'E' || c == '+' || c == '-'; };
-      bool replaced = false;
-      for (std::size_t p = text.find(token); p != std::string::npos; p = text.find(token, p + 1)) {
-        if ((p > 0 && is_num(text[p - 1])) || (p + token.size() < text.size() && is_num(text[p + token.size()]))) continue;
-        text.replace(p, token.size(), "\"" + std::string(overflow_marker) + "\"");
-        replaced = true;
+  std::string marked;
+  marked.reserve(text.size());
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size();) {
+    const char c = text[i];
+    if (in_string) {
+      marked += c;
+      if (c == '\\' && i + 1 < text.size()) {
+        marked += text[i + 1];
+        i += 2;
+        continue;
       }
-      if (!replaced) ctx.fail("", std::string("invalid JSON: ") + e.what());
+      if (c == '"') in_string = false;
+      ++i;
+      continue;
     }
+    if (c == '"') {
+      in_string = true;
+      marked += c;
+      ++i;
+      continue;
+    }
+    if (c == '-' || (c >= '0' && c <= '9')) {
+      std::size_t end = i + 1;
+      const auto is_num = [](char d) { return (d >= '0' && d <= '9') || d == '.' || d == 'e' || d == 'E' || d == '+' || d == '-'; };
+      while (end < text.size() && is_num(text[end])) ++end;
+      const std::string token = text.substr(i, end - i);
+      // strtod: an overflowing literal gives +-HUGE_VAL (an underflowing
+      // one 0, which JSON readers also take).
+      const double v = std::strtod(token.c_str(), nullptr);
+      if (std::isinf(v))
+        marked += "\"" + std::string(overflow_marker) + "\"";
+      else
+        marked += token;
+      i = end;
+      continue;
+    }
+    marked += c;
+    ++i;
   }
-  ctx.fail("", "invalid JSON: too many overflowing numbers");
+  try {
+    return json::parse(marked);
+  } catch (const json::exception& e) {
+    std::string what = e.what();
+    // "[json.exception.parse_error.101] parse error at line 3, column 5: ..." -> keep the readable part.
+    if (const auto p = what.find("parse error"); p != std::string::npos) what = what.substr(p);
+    ctx.fail("", "invalid JSON: " + pbrt::quote_prefix(what, 300));
+  }
 }
 
 // Accessors that check presence, type and finiteness.
@@ -88,6 +113,8 @@ struct reader {
     if (!j.is_number()) ctx.fail(place, std::string("expected a number, got ") + type_name(j));
     const double v = j.get<double>();
     if (!std::isfinite(v)) ctx.fail(place, "number is not finite");
+    // Every value of a scene becomes a float: beyond 3.4e38 it is infinite.
+    if (!std::isfinite(static_cast<float>(v))) ctx.fail(place, "number is not finite in single precision (beyond 3.4e38)");
     return v;
   }
   double number(const json& obj, const std::string& path, const std::string& key) const {
@@ -388,8 +415,9 @@ bool is_pbrt_file(const std::string& path) { return path.ends_with(".pbrt") || p
 namespace {
 
 loaded_scene load_pbrt_scene(const std::string& path, std::optional<light_sampling> override_strategy,
-                             const auto_params& ap, bool auto_pilot) {
+                             const auto_params& ap, bool auto_pilot, std::uint64_t max_input_bytes) {
   pbrt::build_options opt;
+  opt.max_input_bytes = max_input_bytes;
   opt.strategy = override_strategy;
   opt.auto_rule = ap;
   opt.auto_pilot = auto_pilot;
@@ -407,8 +435,12 @@ loaded_scene load_pbrt_scene(const std::string& path, std::optional<light_sampli
   out.world = std::move(b.world);
   out.cam.width = b.film.width;
   out.cam.height = b.film.height;
-  out.make_camera = [cfw = b.camera_from_world, pp = b.perspective](int w, int h) {
-    return pbrt::perspective_camera(cfw, pp, w, h);
+  out.make_camera = [cfw = b.camera_from_world, pp = b.perspective, path](int w, int h) {
+    try {
+      return pbrt::perspective_camera(cfw, pp, w, h);
+    } catch (const std::domain_error& e) {
+      throw input_error(path + ": at " + std::to_string(w) + " x " + std::to_string(h) + " pixels: " + e.what());
+    }
   };
   out.spp = b.spp;
   out.max_depth = b.max_depth;
@@ -427,16 +459,18 @@ loaded_scene load_pbrt_scene(const std::string& path, std::optional<light_sampli
 }  // namespace
 
 loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy, ellipse_map map,
-                        const auto_params& ap, bool auto_pilot, std::span<const auto_receiver> auto_receivers) {
-  if (is_pbrt_file(path)) return load_pbrt_scene(path, override_strategy, ap, auto_pilot);
+                        const auto_params& ap, bool auto_pilot, std::span<const auto_receiver> auto_receivers,
+                        std::uint64_t max_input_bytes) {
+  if (is_pbrt_file(path)) return load_pbrt_scene(path, override_strategy, ap, auto_pilot, max_input_bytes);
   const context ctx{path};
   const reader rd{ctx};
-  std::ifstream in(path, std::ios::binary);
-  if (!in) ctx.fail("", "cannot open the scene file");
-  if (std::filesystem::is_directory(path)) ctx.fail("", "is a directory, not a scene file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const json root = parse_json(buffer.str(), ctx);
+  std::string text;
+  try {
+    text = io::read_input_file(path, max_input_bytes);
+  } catch (const io::input_file_error& e) {
+    ctx.fail("", std::string("cannot read the scene file: ") + e.what());
+  }
+  const json root = parse_json(std::move(text), ctx);
   if (!root.is_object()) ctx.fail("", std::string("expected a JSON object at the top level, got ") + type_name(root));
   rd.only(root, "", {"camera", "render", "materials", "objects"});
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "input_file.hpp"
 #include "mcrt/mcrt.hpp"
 
 namespace mcrt::cli {
@@ -84,8 +85,12 @@ std::optional<light_sampling> parse_light_sampling_flag(const std::string& value
 // Whether a path names a pbrt-v4 file (.pbrt, .pbrt.gz).
 bool is_pbrt_file(const std::string& path);
 
+// max_input_bytes: --max-input-size; no file the scene reads (the scene,
+// files it includes, PLY meshes, images) is read past this many bytes, nor
+// a gzip-compressed one's unpacked stream (input_file.hpp).
 loaded_scene load_scene(const std::string& path, std::optional<light_sampling> override_strategy = std::nullopt,
                         ellipse_map map = ellipse_map::parallel, const auto_params& ap = {}, bool auto_pilot = false,
-                        std::span<const auto_receiver> auto_receivers = {});
+                        std::span<const auto_receiver> auto_receivers = {},
+                        std::uint64_t max_input_bytes = io::default_max_input_bytes);
 
 }  // namespace mcrt::cli

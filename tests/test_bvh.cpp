@@ -7,10 +7,12 @@
 // node's box holds its children's and its primitives', leaves hold at most
 // max_leaf_size, its depth fits the traversal's stack, also for degenerate
 // inputs (every primitive in one place, coordinates spread over 30 decades);
-// and a tree whose traversal nodes take huge-page storage.
+// rays with NaN and infinite components through trees of identical and huge
+// bounds; and a tree whose traversal nodes take huge-page storage.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -235,6 +237,91 @@ TEST(Bvh, DegenerateInputs) {
   float t_empty = infinity;
   EXPECT_EQ(t3.closest({{0, 0, 0}, {0, 0, 1}}, 0.0f, t_empty, [](std::uint32_t, float, float) { return 0.0f; }), -1);
   EXPECT_FALSE(t3.any({{0, 0, 0}, {0, 0, 1}}, 0.0f, infinity, [](std::uint32_t, float, float) { return true; }));
+}
+
+// Rays with NaN and infinite components (origin, direction, tmin, tmax)
+// through trees of ordinary, identical and huge bounds (vertices at
+// +-FLT_MAX): every query returns what testing every primitive returns,
+// and visits each leaf at most once (the traversal's stack holds each node
+// once: a ray whose slab test turns NaN must not enter a node's unused
+// lanes, which name the root; that overflowed the stack once).
+TEST(Bvh, NonFiniteRaysAndExtremeBounds) {
+  pcg32 rng(31, 7);
+  constexpr float big = std::numeric_limits<float>::max(), nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<soup> soups;
+  soups.push_back(random_soup(rng, 3000, 10.0f, 1.0f));
+  soup same;  // 1000 identical triangles
+  for (int i = 0; i < 1000; ++i) same.a.push_back({0, 0, 0}), same.b.push_back({1, 0, 0}), same.c.push_back({0, 1, 0});
+  soups.push_back(same);
+  soup huge = random_soup(rng, 500, 10.0f, 1.0f);  // ordinary triangles beside ones reaching +-FLT_MAX
+  for (int i = 0; i < 200; ++i) {
+    const float x = (rng.uniform() - 0.5f) * 10.0f;
+    huge.a.push_back({x, 0, 0});
+    huge.b.push_back({i % 2 ? big : -big, 1, 0});
+    huge.c.push_back({x, i % 3 ? big : -big, 1});
+  }
+  soups.push_back(huge);
+  soup all_huge;  // every box [-FLT_MAX, FLT_MAX]^3
+  for (int i = 0; i < 300; ++i)
+    all_huge.a.push_back({-big, -big, -big}), all_huge.b.push_back({big, big, big}), all_huge.c.push_back({big, -big, big});
+  soups.push_back(all_huge);
+  const std::array<float, 10> values{0.0f, -0.0f, 1.0f, -1.0f, 0.5f, big, -big, infinity, -infinity, nan};
+  for (const soup& s : soups) {
+    const std::vector<aabb> b = s.bounds();
+    for (const int leaf_block : {1, triangle_leaf_width}) {
+      const bvh tree(b, leaf_block);
+      EXPECT_LE(check_tree(tree, b), 128);
+      const std::size_t leaves = std::count_if(tree.nodes().begin(), tree.nodes().end(), [](const bvh::node& nd) { return nd.count > 0; });
+      for (int k = 0; k < 4000; ++k) {
+        const auto pick = [&] { return values[static_cast<std::size_t>(rng.uniform() * float(values.size())) % values.size()]; };
+        // Each component ordinary or one of the extreme values.
+        vec3 o{(rng.uniform() - 0.5f) * 15.0f, (rng.uniform() - 0.5f) * 15.0f, (rng.uniform() - 0.5f) * 15.0f};
+        vec3 d = square_to_uniform_sphere(rng.uniform2());
+        for (int a = 0; a < 3; ++a) {
+          if (rng.uniform() < 0.3f) o[a] = pick();
+          if (rng.uniform() < 0.3f) d[a] = pick();
+        }
+        const float tmin = rng.uniform() < 0.1f ? pick() : 0.0f;
+        const float tmax0 = rng.uniform() < 0.2f ? pick() : infinity;
+        const ray r{o, d};
+        float brute_t = tmax0;
+        std::int64_t brute_i = -1;
+        for (std::uint32_t i = 0; i < s.a.size(); ++i) {
+          const float t = s.hit(i, r, brute_t);
+          if (t < brute_t && t > tmin) brute_t = t, brute_i = i;
+        }
+        std::vector<int> visits(s.a.size(), 0);
+        float tree_t = tmax0;
+        const std::int64_t tree_i = tree.closest(r, tmin, tree_t, [&](std::uint32_t i, float t0, float tmax) {
+          ++visits[i];
+          const float t = s.hit(i, r, tmax);
+          return t > t0 ? t : infinity;
+        });
+        for (std::size_t i = 0; i < visits.size(); ++i) ASSERT_LE(visits[i], 1) << "primitive visited twice, ray " << k;
+        ASSERT_EQ(tree_i >= 0, brute_i >= 0) << "ray " << k;
+        if (brute_i >= 0) ASSERT_EQ(tree_t, brute_t) << "ray " << k;
+        std::size_t leaf_visits = 0;
+        tree.any(r, tmin, tmax0, [&](std::uint32_t, float, float) {
+          ++leaf_visits;
+          return false;
+        });
+        ASSERT_LE(leaf_visits, s.a.size()) << "ray " << k;
+        std::size_t leaf_calls = 0;
+        float t_leaf = tmax0;
+        tree.closest_leaf(r, tmin, t_leaf, [&](std::uint32_t, std::uint32_t, float, float&) {
+          ++leaf_calls;
+          return std::int64_t(-1);
+        });
+        ASSERT_LE(leaf_calls, leaves) << "ray " << k;
+        leaf_calls = 0;
+        tree.any_leaf(r, tmin, tmax0, [&](std::uint32_t, std::uint32_t, float, float) {
+          ++leaf_calls;
+          return false;
+        });
+        ASSERT_LE(leaf_calls, leaves) << "ray " << k;
+      }
+    }
+  }
 }
 
 TEST(Bvh, TraversalTestsFewPrimitivesPerRay) {

@@ -192,7 +192,7 @@ TEST(PbrtParser, BadSyntaxNamesTheFileAndTheLine) {
       {"AttributeBegin\nAttributeEnd\nAttributeEnd", "test.pbrt:3: AttributeEnd without a matching AttributeBegin"},
       {"\n\nAttributeBegin\nShape \"sphere\"", "test.pbrt:3: AttributeBegin without its matching end"},
       {"AttributeBegin\nTransformEnd", "test.pbrt:2: TransformEnd closes the AttributeBegin of line 1"},
-      {"Include \"no/such/file.pbrt\"", "test.pbrt:1: cannot open"},
+      {"Include \"no/such/file.pbrt\"", "test.pbrt:1: 'no/such/file.pbrt': no such file"},
   };
   for (const auto& [text, needle] : bad) {
     const std::string e = error_of(text);
@@ -233,7 +233,19 @@ TEST(PbrtParser, IncludeAndImportResolveAgainstTheTopLevelDirectory) {
     parse_file(loop.string());
     FAIL() << "no error";
   } catch (const parse_error& e) {
-    EXPECT_NE(std::string(e.what()).find("nested deeper than"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("loop.pbrt:1: Include: 'loop.pbrt' includes itself (loop.pbrt -> loop.pbrt)"),
+              std::string::npos)
+        << e.what();
+  }
+  // A chain of distinct files deeper than the bound.
+  for (int i = 0; i < 70; ++i)
+    dir.write("chain/" + std::to_string(i) + ".pbrt", "Include \"chain/" + std::to_string(i + 1) + ".pbrt\"\n");
+  dir.write("chain/70.pbrt", "Identity\n");
+  try {
+    parse_file(dir.write("chain.pbrt", "Include \"chain/0.pbrt\"\n").string());
+    FAIL() << "no error";
+  } catch (const parse_error& e) {
+    EXPECT_NE(std::string(e.what()).find("nested deeper than 64"), std::string::npos) << e.what();
   }
 }
 

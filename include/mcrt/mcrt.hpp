@@ -9,6 +9,7 @@
 #include "mcrt/core/onb.hpp"
 #include "mcrt/core/ray.hpp"
 #include "mcrt/core/rng.hpp"
+#include "mcrt/core/worker_errors.hpp"
 #include "mcrt/geometry/aabb.hpp"
 #include "mcrt/geometry/axis_rect.hpp"
 #include "mcrt/geometry/axis_rect_set.hpp"

@@ -16,7 +16,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string quoted(const std::string& s) { return "\"" + s + "\""; }
+// A name or value from the file in a message (bounded: tokenizer.hpp).
+std::string quoted(const std::string& s) { return "\"" + quote_prefix(s, 200) + "\""; }
 
 // The command line's limits (docs/cli.md), for what a file asks for.
 constexpr int max_samples_per_pixel = 1 << 20;
@@ -161,6 +162,12 @@ class builder {
     if (!saw_world_) refuse(ds.empty() ? file_loc{} : ds.back().loc, "the file has no WorldBegin");
     if (!stack_.empty()) refuse(ds.back().loc, "AttributeBegin without AttributeEnd");
     if (out_.world.object_count() == 0) refuse(ds.back().loc, "the scene has no shapes");
+    // The camera at the film's resolution, which must fit single precision.
+    try {
+      (void)perspective_camera(out_.camera_from_world, out_.perspective, out_.film.width, out_.film.height);
+    } catch (const std::domain_error& e) {
+      refuse(camera_loc_.file ? camera_loc_ : ds.front().loc, std::string("Camera: ") + e.what());
+    }
     out_.world.build_accelerator();
     out_.world.build_light_tree();
     return std::move(out_);
@@ -176,6 +183,7 @@ class builder {
   std::map<std::string, std::uint32_t> named_materials_;
   std::map<std::string, texture_entry> spectrum_textures_, float_textures_;
   bool saw_world_ = false, saw_camera_ = false;
+  file_loc camera_loc_;  // the Camera directive's place
 
   std::string resolve(const std::string& name) const {
     const fs::path p(name);
@@ -306,6 +314,8 @@ class builder {
     saw_camera_ = true;
     if (d.type != "perspective") refuse(d.loc, "Camera " + quoted(d.type) + ": not supported (supported: perspective)");
     params p(d);
+    if (const std::optional<std::string> why = camera_matrix_problem(state_.ctm)) refuse(d.loc, "Camera: " + *why);
+    camera_loc_ = d.loc;
     out_.camera_from_world = state_.ctm;
     coordinate_systems_["camera"] = state_.ctm.inverse();
     perspective_params& pp = out_.perspective;
@@ -510,6 +520,11 @@ class builder {
       const std::string encoding = p.string("encoding").value_or("sRGB");
       if (!(encoding == "sRGB" || encoding == "linear" || encoding.rfind("gamma ", 0) == 0))
         p.fail(*p.find("encoding"), "must be sRGB, linear or \"gamma G\"");
+      if (encoding.rfind("gamma ", 0) == 0) {
+        const std::optional<double> g = parse_number(encoding.substr(6));
+        if (!g || !(*g > 0.0) || !std::isfinite(static_cast<float>(*g)))
+          p.fail(*p.find("encoding"), "must be \"gamma G\" with a finite G > 0");
+      }
       const std::string wrap = p.string("wrap").value_or("repeat");
       if (wrap == "repeat")
         t->wrap = texture_wrap::repeat;
@@ -529,14 +544,14 @@ class builder {
       if (!opt_.decode_image) p.fail("images cannot be decoded here");
       const std::string path = resolve(*file);
       try {
-        auto img = std::make_shared<texture_image>(opt_.decode_image(path, encoding));
+        auto img = std::make_shared<texture_image>(opt_.decode_image(path, encoding, opt_.max_input_bytes));
         if (is_float)
           for (color& c : img->texels) c = color((c.r + c.g + c.b) / 3.0f);
         t->img = std::move(img);
       } catch (const parse_error&) {
         throw;
       } catch (const std::exception& e) {
-        refuse(p.loc(), "Texture " + quoted(name) + ": " + path + ": " + e.what());
+        refuse(p.loc(), "Texture " + quoted(name) + ": " + quote_prefix(path, 200) + ": " + e.what());
       }
     } else {
       refuse(d.loc, "Texture " + quoted(name) + " class " + quoted(cls) +
@@ -625,12 +640,15 @@ class builder {
     // of luminance 1 here), scale divided by L's luminance (an rgb L is
     // taken as it is: mcrt renders in RGB, pbrt-v4 divides by its
     // illuminant's luminance only).
-    const param* lp = p.find("L");
     color L = spectrum(p, "L", spectrum_use::illuminant).value_or(color(1.0f));
     const float scale = static_cast<float>(p.real("scale", 1.0));
+    // A negative scale would make a light of negative power, which no
+    // light selection can choose by (pbrt-v4 does not check it either).
+    if (!(scale >= 0.0f)) p.fail(*p.find("scale"), "must be >= 0");
     L *= scale;
+    if (!all_finite(L))
+      p.fail("the radiance L times scale overflows single precision (beyond 3.4e38)");
     l.twosided = p.boolean("twosided", false);
-    (void)lp;
     if (p.find("filename")) p.fail(*p.find("filename"), "(an image on the light) is not supported");
     if (p.find("power")) p.fail(*p.find("power"), "is not supported");
     p.finish();
@@ -726,7 +744,7 @@ class builder {
       p.finish();
       triangle_mesh m;
       try {
-        m = read_ply(resolve(*file));
+        m = read_ply(resolve(*file), opt_.max_input_bytes);
       } catch (const parse_error& e) {
         // Both places: the directive, and the PLY file's own.
         p.fail(e.what());
@@ -971,7 +989,9 @@ built_scene build_scene(const std::vector<directive>& directives, const std::str
 }
 
 built_scene load_pbrt_file(const std::string& path, const build_options& options) {
-  const std::vector<directive> ds = parse_file(path);
+  parse_options po;
+  po.max_input_bytes = options.max_input_bytes;
+  const std::vector<directive> ds = parse_file(path, po);
   return build_scene(ds, fs::path(path).parent_path().string(), options);
 }
 

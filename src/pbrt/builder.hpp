@@ -65,7 +65,10 @@ struct built_scene {
 // with the texture's `encoding`: "sRGB", "linear" or "gamma G"); throws
 // std::runtime_error with the reason. Supplied by the executable
 // (OpenImageIO), so that this layer needs no image library.
-using image_decoder = std::function<texture_image(const std::string& path, const std::string& encoding)>;
+// An image whose decoded texels would take more than max_bytes bytes is
+// refused from its header, before it is decoded.
+using image_decoder =
+    std::function<texture_image(const std::string& path, const std::string& encoding, std::uint64_t max_bytes)>;
 
 struct build_options {
   // Every emitter sampled by this strategy instead of its default (area):
@@ -77,6 +80,10 @@ struct build_options {
   auto_params auto_rule;
   bool auto_pilot = false;
   image_decoder decode_image;
+  // No file (scene text, PLY mesh, image) is read past this many bytes, nor
+  // a gzip-compressed one's unpacked stream (src/input_file.hpp): the
+  // executable's --max-input-size.
+  std::uint64_t max_input_bytes = io::default_max_input_bytes;
 };
 
 // The scene of a parsed file; `scene_directory` resolves relative file
@@ -85,7 +92,7 @@ struct build_options {
 built_scene build_scene(const std::vector<directive>& directives, const std::string& scene_directory,
                         const build_options& options = {});
 
-// parse_file then build_scene.
+// parse_file (with options.max_input_bytes) then build_scene.
 built_scene load_pbrt_file(const std::string& path, const build_options& options = {});
 
 }  // namespace mcrt::pbrt

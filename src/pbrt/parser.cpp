@@ -88,37 +88,27 @@ std::optional<param_syntax> param_type(std::string_view t) {
   return std::nullopt;
 }
 
-// A number as pbrt writes it: an optional sign, digits with an optional
-// point, an optional exponent ("-2", "+3.5", ".5", "5.", "1e-3").
-std::optional<double> parse_number(const std::string& w) {
-  if (w.empty()) return std::nullopt;
-  std::size_t i = 0;
-  if (w[0] == '+') i = 1;
-  if (i == 1 && w.size() > 1 && w[1] == '-') return std::nullopt;
-  const char* first = w.data() + i;
-  const char* last = w.data() + w.size();
-  if (first == last || !(std::isdigit(static_cast<unsigned char>(*first)) || *first == '.' || *first == '-'))
-    return std::nullopt;
-  double v = 0.0;
-  const auto [ptr, ec] = std::from_chars(first, last, v, std::chars_format::general);
-  if (ptr != last) return std::nullopt;
-  if (ec == std::errc::result_out_of_range) return std::numeric_limits<double>::infinity();
-  if (ec != std::errc()) return std::nullopt;
-  return v;
-}
-
 class parser {
  public:
   parser(const parse_options& options, std::vector<directive>& out) : options_(options), out_(out) {}
 
   void parse(std::string text, const std::string& name, int depth) {
+    // Every file's text counts, each time it is included: a few small files
+    // that include each other twice over would otherwise make 2^depth
+    // copies (the depth bound alone lets that run for ever).
+    total_bytes_ += text.size();
+    if (total_bytes_ > options_.max_input_bytes)
+      throw parse_error(file_loc{std::make_shared<const std::string>(name), 1, 1},
+                        "the scene's text with its Includes (each counted as often as it is included) is more than " +
+                            io::byte_count(options_.max_input_bytes) + " (--max-input-size raises the bound)");
+    open_files_.push_back(canonical(name));
     tokenizer tok(std::move(text), name);
     token t = tok.next();
     while (t.k != token::kind::end) {
       if (t.k != token::kind::word) throw parse_error(t.loc, "expected a directive, got " + describe(t));
       const auto it = directives().find(t.text);
       if (it == directives().end())
-        throw parse_error(t.loc, "unknown directive '" + t.text + "' (directives: " + directive_names() + ")");
+        throw parse_error(t.loc, "unknown directive '" + quote_prefix(t.text) + "' (directives: " + directive_names() + ")");
       directive d;
       d.name = t.text;
       d.loc = t.loc;
@@ -133,28 +123,43 @@ class parser {
     }
     if (depth == 0 && !open_.empty())
       throw parse_error(open_.back().second, open_.back().first + " without its matching end");
+    open_files_.pop_back();
   }
 
  private:
   const parse_options& options_;
   std::vector<directive>& out_;
   std::vector<std::pair<std::string, file_loc>> open_;  // AttributeBegin, TransformBegin, ObjectBegin
+  std::vector<std::string> open_files_;  // the files being read, the including before the included
+  std::uint64_t total_bytes_ = 0;        // the text read so far, Includes counted each time
+  std::uint64_t includes_ = 0;           // the Includes read so far
+
+  static std::string canonical(const std::string& file) {
+    std::error_code ec;
+    const fs::path p = fs::weakly_canonical(fs::path(file), ec);
+    return ec ? fs::path(file).lexically_normal().string() : p.string();
+  }
 
   static std::string describe(const token& t) {
     switch (t.k) {
-      case token::kind::string: return "the string \"" + t.text + "\"";
+      case token::kind::string: return "the string \"" + quote_prefix(t.text) + "\"";
       case token::kind::open_bracket: return "'['";
       case token::kind::close_bracket: return "']'";
       case token::kind::end: return "the end of the file";
-      default: return "'" + t.text + "'";
+      default: return "'" + quote_prefix(t.text) + "'";
     }
   }
 
   static double number(const token& t, const std::string& what) {
     if (t.k != token::kind::word) throw parse_error(t.loc, what + ": expected a number, got " + describe(t));
     const std::optional<double> v = parse_number(t.text);
-    if (!v) throw parse_error(t.loc, what + ": '" + t.text + "' is not a number");
-    if (!std::isfinite(*v)) throw parse_error(t.loc, what + ": '" + t.text + "' is not a finite number");
+    if (!v) throw parse_error(t.loc, what + ": '" + quote_prefix(t.text) + "' is not a number");
+    if (!std::isfinite(*v)) throw parse_error(t.loc, what + ": '" + quote_prefix(t.text) + "' is not a finite number");
+    // pbrt-v4 reads every value in single precision (its Float): beyond
+    // FLT_MAX a value is infinite there, and mcrt's geometry, colours and
+    // parameters are floats too.
+    if (!std::isfinite(static_cast<float>(*v)))
+      throw parse_error(t.loc, what + ": '" + quote_prefix(t.text) + "' is not finite in single precision (beyond 3.4e38)");
     return *v;
   }
 
@@ -224,34 +229,35 @@ class parser {
       p.loc = t.loc;
       // "type name": two words separated by white space.
       const std::string decl = t.text;  // (a copy: t moves on below)
+      const std::string shown = quote_prefix(decl);  // for messages
       const std::size_t a = decl.find_first_not_of(" \t");
       const std::size_t b = decl.find_first_of(" \t", a);
       const std::size_t c = b == std::string::npos ? b : decl.find_first_not_of(" \t", b);
       const std::size_t e = c == std::string::npos ? c : decl.find_first_of(" \t", c);
       if (a == std::string::npos || c == std::string::npos ||
           (e != std::string::npos && decl.find_first_not_of(" \t", e) != std::string::npos))
-        throw parse_error(t.loc, d.name + ": expected a parameter \"TYPE NAME\", got the string \"" + decl + "\"");
+        throw parse_error(t.loc, d.name + ": expected a parameter \"TYPE NAME\", got the string \"" + shown + "\"");
       p.type = decl.substr(a, b - a);
       p.name = decl.substr(c, e == std::string::npos ? std::string::npos : e - c);
       const std::optional<param_syntax> syntax = param_type(p.type);
       if (!syntax)
-        throw parse_error(t.loc, "parameter \"" + decl + "\": unknown type '" + p.type +
+        throw parse_error(t.loc, "parameter \"" + shown + "\": unknown type '" + quote_prefix(p.type) +
                                      "' (integer, float, point2, vector2, point3, vector3, normal, rgb, blackbody, "
                                      "spectrum, bool, string, texture)");
       for (const param& q : d.params)
-        if (q.name == p.name) throw parse_error(t.loc, "parameter '" + p.name + "' given twice");
+        if (q.name == p.name) throw parse_error(t.loc, "parameter '" + quote_prefix(p.name) + "' given twice");
       t = tok.next();
       std::vector<token> values;
       if (t.k == token::kind::open_bracket) {
         for (t = tok.next(); t.k != token::kind::close_bracket; t = tok.next()) {
           if (t.k == token::kind::end || t.k == token::kind::open_bracket)
-            throw parse_error(p.loc, "parameter \"" + decl + "\": no closing ']'");
+            throw parse_error(p.loc, "parameter \"" + shown + "\": no closing ']'");
           values.push_back(t);
         }
         t = tok.next();
       } else {
         if (t.k != token::kind::word && t.k != token::kind::string)
-          throw parse_error(t.loc, "parameter \"" + decl + "\": expected a value, got " + describe(t));
+          throw parse_error(t.loc, "parameter \"" + shown + "\": expected a value, got " + describe(t));
         values.push_back(t);
         t = tok.next();
       }
@@ -262,7 +268,7 @@ class parser {
   }
 
   static void fill(param& p, const param_syntax& s, const std::vector<token>& values) {
-    const std::string what = "parameter \"" + p.type + " " + p.name + "\"";
+    const std::string what = "parameter \"" + p.type + " " + quote_prefix(p.name) + "\"";
     if (values.empty()) throw parse_error(p.loc, what + ": no values");
     const bool strings = values.front().k == token::kind::string;
     if (s.kind == value_kind::string || (s.kind == value_kind::spectrum && strings)) {
@@ -285,7 +291,7 @@ class parser {
     for (const token& v : values) {
       const double x = number(v, what);
       if (s.kind == value_kind::integer && (x != std::floor(x) || std::abs(x) > 2147483647.0))
-        throw parse_error(v.loc, what + ": '" + v.text + "' is not an integer");
+        throw parse_error(v.loc, what + ": '" + quote_prefix(v.text) + "' is not an integer");
       p.numbers.push_back(x);
     }
     const std::size_t n = p.numbers.size();
@@ -315,16 +321,47 @@ class parser {
   }
 
   void include(const directive& d, int depth) {
+    if (++includes_ > options_.max_includes)
+      throw parse_error(d.loc, d.name + ": more than " + std::to_string(options_.max_includes) +
+                                   " files included in all (each Include counted every time it is read)");
     if (depth + 1 > options_.max_include_depth)
       throw parse_error(d.loc, d.name + ": includes nested deeper than " + std::to_string(options_.max_include_depth));
     fs::path p(d.strings.at(0));
     if (p.is_relative() && !options_.search_directory.empty()) p = fs::path(options_.search_directory) / p;
     const std::string file = p.lexically_normal().string();
-    parse(read_scene_text(file, d.loc), file, depth + 1);
+    // A file that includes itself, directly or through others, never ends.
+    const std::string key = canonical(file);
+    for (std::size_t i = 0; i < open_files_.size(); ++i)
+      if (open_files_[i] == key) {
+        std::string chain;
+        for (std::size_t j = i; j < open_files_.size(); ++j) chain += fs::path(open_files_[j]).filename().string() + " -> ";
+        throw parse_error(d.loc, d.name + ": '" + quote_prefix(d.strings.at(0), 200) + "' includes itself (" +
+                                     quote_prefix(chain + fs::path(key).filename().string(), 300) + ")");
+      }
+    parse(read_scene_text(file, d.loc, options_.max_input_bytes), file, depth + 1);
   }
 };
 
 }  // namespace
+
+// A number as pbrt writes it: an optional sign, digits with an optional
+// point, an optional exponent ("-2", "+3.5", ".5", "5.", "1e-3").
+std::optional<double> parse_number(const std::string& w) {
+  if (w.empty()) return std::nullopt;
+  std::size_t i = 0;
+  if (w[0] == '+') i = 1;
+  if (i == 1 && w.size() > 1 && w[1] == '-') return std::nullopt;
+  const char* first = w.data() + i;
+  const char* last = w.data() + w.size();
+  if (first == last || !(std::isdigit(static_cast<unsigned char>(*first)) || *first == '.' || *first == '-'))
+    return std::nullopt;
+  double v = 0.0;
+  const auto [ptr, ec] = std::from_chars(first, last, v, std::chars_format::general);
+  if (ptr != last) return std::nullopt;
+  if (ec == std::errc::result_out_of_range) return std::numeric_limits<double>::infinity();
+  if (ec != std::errc()) return std::nullopt;
+  return v;
+}
 
 const param* directive::find(const std::string& param_name) const {
   for (const param& p : params)
@@ -345,7 +382,11 @@ std::vector<directive> parse_file(const std::string& path, const parse_options& 
     if (o.search_directory.empty()) o.search_directory = ".";
   }
   const auto name = std::make_shared<const std::string>(path);
-  return parse_text(read_scene_text(path, file_loc{name, 1, 1}), path, o);
+  std::vector<directive> ds = parse_text(read_scene_text(path, file_loc{name, 1, 1}, o.max_input_bytes), path, o);
+  // (An empty file, or one of comments and white space only: named here,
+  // where its name is known.)
+  if (ds.empty()) throw parse_error(file_loc{name, 1, 1}, "the file has no directives (no WorldBegin)");
+  return ds;
 }
 
 }  // namespace mcrt::pbrt

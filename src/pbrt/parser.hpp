@@ -17,9 +17,11 @@
 // Parameter types: integer, float, point2, vector2, point3, vector3,
 // normal (normal3), rgb, blackbody, spectrum, bool, string, texture (and the
 // older point, vector, color for point3, vector3, rgb).
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "input_file.hpp"
 #include "pbrt/tokenizer.hpp"
 
 namespace mcrt::pbrt {
@@ -57,7 +59,17 @@ struct parse_options {
   // Includes nested deeper than this are refused (a file that includes
   // itself).
   int max_include_depth = 64;
+  // Includes read in all, each time counted: a few files that include each
+  // other twice over would make 2^depth of them.
+  std::uint64_t max_includes = 100000;
+  // No file is read past this many bytes (nor a .gz file's unpacked
+  // stream): src/input_file.hpp, the executable's --max-input-size.
+  std::uint64_t max_input_bytes = io::default_max_input_bytes;
 };
+
+// A number as pbrt writes it ("-2", "+3.5", ".5", "5.", "1e-3"): its value
+// (infinity where it overflows a double), or nullopt where it is not one.
+std::optional<double> parse_number(const std::string& word);
 
 // The directives of a scene file and of the files it includes, in order,
 // Include and Import replaced by the included files' directives. Throws

@@ -1,11 +1,15 @@
 #include "pbrt/ply.hpp"
 
+#include "input_file.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <sstream>
 
@@ -102,21 +106,26 @@ class cursor {
     if (ec != std::errc() || ptr != b_.data() + pos_)
       throw parse_error(loc_, what + ": '" + b_.substr(start, std::min<std::size_t>(pos_ - start, 40)) + "' is not a number");
     if (is_integer(s) && v != std::floor(v))
-      throw parse_error(loc_, what + ": '" + b_.substr(start, pos_ - start) + "' is not an integer");
+      throw parse_error(loc_, what + ": '" + quote_prefix(b_.substr(start, pos_ - start)) + "' is not an integer");
     return v;
   }
 };
 
-}  // namespace
 
-triangle_mesh read_ply_bytes(const std::string& bytes, const std::string& name, ply_stats* stats) {
-  const auto file = std::make_shared<const std::string>(name);
-  file_loc loc{file, 1, 1};
-  const auto fail = [&](int line, const std::string& what) -> parse_error {
-    return parse_error(file_loc{file, line, 1}, "PLY: " + what);
-  };
+// What a PLY header says: the data's format and its elements, and where
+// the data begins (the byte after end_header's line, header_lines lines in).
+struct ply_header {
+  format fmt = format::ascii;
+  std::vector<element> elements;
+  std::size_t body = 0;
+  int lines = 0;
+};
 
-  // ---- header
+using fail_fn = std::function<parse_error(int line, const std::string& what)>;
+
+// Reads the header at the start of `bytes`, which must hold it whole.
+ply_header parse_header(const std::string& bytes, const fail_fn& fail) {
+  ply_header h;
   std::size_t pos = 0;
   int line_no = 0;
   const auto next_line = [&](std::string& out) {
@@ -148,14 +157,14 @@ triangle_mesh read_ply_bytes(const std::string& bytes, const std::string& name, 
       if (f == "ascii") fmt = format::ascii;
       else if (f == "binary_little_endian") fmt = format::little;
       else if (f == "binary_big_endian") fmt = format::big;
-      else throw fail(line_no, "unknown format '" + f + "'");
-      if (version != "1.0") throw fail(line_no, "unknown format version '" + version + "'");
+      else throw fail(line_no, "unknown format '" + quote_prefix(f) + "'");
+      if (version != "1.0") throw fail(line_no, "unknown format version '" + quote_prefix(version) + "'");
       have_format = true;
     } else if (word == "element") {
       element e;
       long long count = -1;
       in >> e.name >> count;
-      if (e.name.empty() || count < 0 || in.fail()) throw fail(line_no, "bad element line '" + line + "'");
+      if (e.name.empty() || count < 0 || in.fail()) throw fail(line_no, "bad element line '" + quote_prefix(line) + "'");
       e.count = static_cast<std::size_t>(count);
       e.line = line_no;
       elements.push_back(std::move(e));
@@ -168,26 +177,60 @@ triangle_mesh read_ply_bytes(const std::string& bytes, const std::string& name, 
         std::string ct, it;
         in >> ct >> it >> p.name;
         const auto c = scalar_named(ct), i = scalar_named(it);
-        if (!c || !i || !is_integer(*c)) throw fail(line_no, "bad list property '" + line + "'");
+        if (!c || !i || !is_integer(*c)) throw fail(line_no, "bad list property '" + quote_prefix(line) + "'");
         p.list = true;
         p.count_type = *c;
         p.type = *i;
       } else {
         in >> p.name;
         const auto s = scalar_named(t);
-        if (!s) throw fail(line_no, "unknown property type '" + t + "'");
+        if (!s) throw fail(line_no, "unknown property type '" + quote_prefix(t) + "'");
         p.type = *s;
       }
       if (p.name.empty()) throw fail(line_no, "a property without a name");
       elements.back().properties.push_back(p);
     } else {
-      throw fail(line_no, "unknown header line '" + line + "'");
+      throw fail(line_no, "unknown header line '" + quote_prefix(line) + "'");
     }
   }
   if (!ended) throw fail(line_no, "the header has no end_header (truncated)");
   if (!have_format) throw fail(2, "no format line");
+  h.fmt = fmt;
+  h.elements = std::move(elements);
+  h.body = pos;
+  h.lines = line_no;
+  return h;
+}
 
-  // ---- data
+// The fewest bytes an element's entry takes: a byte or more per value
+// (binary; a list at least its count), two characters per value (ASCII:
+// a digit and a separator).
+std::size_t min_entry_bytes(const element& e, format fmt) {
+  if (fmt == format::ascii) return 2 * e.properties.size();
+  std::size_t n = 0;
+  for (const property& p : e.properties) n += p.list ? size_of(p.count_type) : size_of(p.type);
+  return n;
+}
+
+// Refuses a header whose counts the data cannot hold (`available` bytes at
+// most), before the data is read or anything is allocated for it.
+void check_counts(const ply_header& h, std::uint64_t available, const fail_fn& fail) {
+  std::uint64_t need = 0;
+  for (const element& e : h.elements) {
+    const std::uint64_t m = min_entry_bytes(e, h.fmt);
+    if (m > 0 && e.count > (available - std::min(need, available)) / m)
+      throw fail(e.line, "element '" + quote_prefix(e.name) + "' has " + std::to_string(e.count) +
+                             " entries, more than the file holds (truncated, or a header that lies)");
+    need += m * e.count;
+  }
+}
+
+triangle_mesh parse_body(const std::string& bytes, const ply_header& h, const std::shared_ptr<const std::string>& file,
+                         const fail_fn& fail, ply_stats* stats) {
+  const format fmt = h.fmt;
+  const std::vector<element>& elements = h.elements;
+  const std::size_t pos = h.body;
+  const int line_no = h.lines;
   triangle_mesh mesh;
   // Quads, in face order with the triangles: planar and convex ones as two
   // triangles; a quad with a repeated corner is the triangle of the other
@@ -218,14 +261,14 @@ triangle_mesh read_ply_bytes(const std::string& bytes, const std::string& name, 
   bool have_faces = false;
   cursor cur(bytes, pos, fmt, file_loc{file, line_no + 1, 1});
   for (const element& e : elements) {
-    // Each element's values take at least a byte each (binary) or two
-    // characters (ASCII): a count the file cannot hold is a truncated or
-    // corrupt file, refused before anything is allocated for it.
-    std::size_t min_bytes = 0;
-    for (const property& p : e.properties) min_bytes += p.list ? size_of(p.count_type) : size_of(p.type);
-    if (fmt == format::ascii) min_bytes = 2 * e.properties.size();
+    // A count the rest of the file cannot hold is a truncated or corrupt
+    // file, refused before anything is allocated for it (check_counts
+    // checked the whole header so; this holds the ASCII data's own pace).
+    const std::size_t min_bytes = min_entry_bytes(e, fmt);
     if (min_bytes > 0 && e.count > cur.remaining() / min_bytes)
-      throw fail(e.line, "element '" + e.name + "' has " + std::to_string(e.count) + " entries, more than the file holds (truncated)");
+      throw fail(e.line, "element '" + quote_prefix(e.name) + "' has " + std::to_string(e.count) + " entries, more than the file holds (truncated)");
+    // An element of no properties has nothing to read, however many entries it claims.
+    if (e.properties.empty() && e.name != "vertex" && e.name != "face") continue;
     if (e.name == "vertex") {
       vertex = &e;
       int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, iu = -1, iv = -1;
@@ -257,8 +300,17 @@ triangle_mesh read_ply_bytes(const std::string& bytes, const std::string& name, 
         const vec3 pt(float(values[std::size_t(ix)]), float(values[std::size_t(iy)]), float(values[std::size_t(iz)]));
         if (!all_finite(pt)) throw fail(e.line, what + ": a coordinate is not finite");
         mesh.p[i] = pt;
-        if (normals) mesh.n[i] = vec3(float(values[std::size_t(inx)]), float(values[std::size_t(iny)]), float(values[std::size_t(inz)]));
-        if (uvs) mesh.uv[i] = vec2(float(values[std::size_t(iu)]), float(values[std::size_t(iv)]));
+        // Shading normals and uv must be finite as the positions must (a
+        // NaN normal would make every shading frame there NaN).
+        if (normals) {
+          mesh.n[i] = vec3(float(values[std::size_t(inx)]), float(values[std::size_t(iny)]), float(values[std::size_t(inz)]));
+          if (!all_finite(mesh.n[i])) throw fail(e.line, what + ": a normal (nx, ny, nz) is not finite");
+        }
+        if (uvs) {
+          mesh.uv[i] = vec2(float(values[std::size_t(iu)]), float(values[std::size_t(iv)]));
+          if (!std::isfinite(mesh.uv[i].x) || !std::isfinite(mesh.uv[i].y))
+            throw fail(e.line, what + ": a texture coordinate (u, v) is not finite");
+        }
       }
       continue;
     }
@@ -310,9 +362,56 @@ triangle_mesh read_ply_bytes(const std::string& bytes, const std::string& name, 
   return mesh;
 }
 
-triangle_mesh read_ply(const std::string& path, ply_stats* stats) {
+fail_fn failer(const std::shared_ptr<const std::string>& file) {
+  return [file](int line, const std::string& what) { return parse_error(file_loc{file, line, 1}, "PLY: " + what); };
+}
+
+}  // namespace
+
+triangle_mesh read_ply_bytes(const std::string& bytes, const std::string& name, ply_stats* stats) {
+  const auto file = std::make_shared<const std::string>(name);
+  const fail_fn fail = failer(file);
+  const ply_header h = parse_header(bytes, fail);
+  check_counts(h, bytes.size() - h.body, fail);
+  return parse_body(bytes, h, file, fail, stats);
+}
+
+triangle_mesh read_ply(const std::string& path, std::uint64_t max_bytes, ply_stats* stats) {
   const auto file = std::make_shared<const std::string>(path);
-  return read_ply_bytes(read_scene_text(path, file_loc{file, 1, 1}), path, stats);
+  const fail_fn fail = failer(file);
+  try {
+    io::input_file in(path, max_bytes);
+    // The header first, read until its end_header line (a header is small:
+    // one that runs past max_header_bytes is not a PLY header) ...
+    constexpr std::size_t max_header_bytes = std::size_t(1) << 20;
+    std::string bytes;
+    char buffer[1 << 14];
+    std::size_t end = std::string::npos;
+    while (true) {
+      const std::size_t n = in.read(buffer, sizeof buffer);
+      const std::size_t from = bytes.size() > 16 ? bytes.size() - 16 : 0;
+      bytes.append(buffer, n);
+      if (bytes.size() >= 4 && !(bytes.starts_with("ply\n") || bytes.starts_with("ply\r")))
+        throw fail(1, "not a PLY file (no 'ply' on its first line)");
+      for (std::size_t k = bytes.find("end_header", from); k != std::string::npos; k = bytes.find("end_header", k + 1))
+        if ((k == 0 || bytes[k - 1] == '\n') && (k + 10 < bytes.size() || n == 0)) {
+          end = k;
+          break;
+        }
+      if (end != std::string::npos || n == 0) break;
+      if (bytes.size() > max_header_bytes)
+        throw fail(1, "no end_header in the first " + io::byte_count(max_header_bytes) + " (not a PLY header)");
+    }
+    const ply_header h = parse_header(bytes, fail);
+    // ... checked against what the file can hold before the data is read.
+    const std::uint64_t have = bytes.size() - std::min(h.body, bytes.size());
+    check_counts(h, have + in.remaining_bound(), fail);
+    bytes += in.read_rest();
+    check_counts(h, bytes.size() - h.body, fail);
+    return parse_body(bytes, h, file, fail, stats);
+  } catch (const io::input_file_error& e) {
+    throw fail(1, e.what());
+  }
 }
 
 }  // namespace mcrt::pbrt

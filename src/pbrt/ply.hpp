@@ -13,6 +13,7 @@
 // refused (mcrt has no bilinear patches).
 #include <string>
 
+#include "input_file.hpp"
 #include "mcrt/geometry/triangle_mesh.hpp"
 #include "pbrt/tokenizer.hpp"
 
@@ -25,9 +26,13 @@ struct ply_stats {
 // The mesh of a PLY file; throws parse_error naming the PLY file (and the
 // header line, or the element, where the problem is): unreadable or
 // truncated files, unknown formats or types, missing x y z or faces,
-// indices out of range, non-finite coordinates, faces other than triangles
-// and quads, non-planar quads.
-triangle_mesh read_ply(const std::string& path, ply_stats* stats = nullptr);
+// indices out of range, non-finite coordinates, normals or uv, faces other
+// than triangles and quads, non-planar quads.
+// The file is read as src/input_file.hpp reads files: only a regular file,
+// at most max_bytes bytes of it (unpacked, for .ply.gz); its header is read
+// and checked against the file's size before the data is.
+triangle_mesh read_ply(const std::string& path, std::uint64_t max_bytes = io::default_max_input_bytes,
+                       ply_stats* stats = nullptr);
 
 // The same from the bytes of a PLY file held in memory (`name` in errors).
 triangle_mesh read_ply_bytes(const std::string& bytes, const std::string& name, ply_stats* stats = nullptr);

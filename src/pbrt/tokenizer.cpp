@@ -1,20 +1,21 @@
 #include "pbrt/tokenizer.hpp"
 
-#include <zlib.h>
-
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
+#include "input_file.hpp"
 
 namespace mcrt::pbrt {
 
 tokenizer::tokenizer(std::string text, std::string file)
-    : text_(std::move(text)), file_(std::make_shared<const std::string>(std::move(file))) {}
+    : text_(std::move(text)), file_(std::make_shared<const std::string>(std::move(file))) {
+  // A UTF-8 byte-order mark, which some editors write at the start of a
+  // file, is skipped (an extension: pbrt-v4 refuses it as a directive).
+  if (text_.starts_with("\xEF\xBB\xBF")) pos_ = 3;
+}
 
+// A line ends at LF, CR LF or a lone CR (classic Mac OS line endings), so
+// that comments end and lines are counted in all three.
 char tokenizer::get() {
   const char c = text_[pos_++];
-  if (c == '\n') {
+  if (c == '\n' || (c == '\r' && (pos_ >= text_.size() || text_[pos_] != '\n'))) {
     ++line_;
     column_ = 1;
   } else {
@@ -31,7 +32,7 @@ token tokenizer::next() {
       continue;
     }
     if (c == '#') {  // a comment runs to the end of the line
-      while (pos_ < text_.size() && text_[pos_] != '\n') get();
+      while (pos_ < text_.size() && text_[pos_] != '\n' && text_[pos_] != '\r') get();
       continue;
     }
     const file_loc start = here();
@@ -46,7 +47,7 @@ token tokenizer::next() {
         if (pos_ >= text_.size()) throw parse_error(start, "unterminated string");
         const char d = get();
         if (d == '"') break;
-        if (d == '\n') throw parse_error(start, "unterminated string (a string may not run over a line)");
+        if (d == '\n' || d == '\r') throw parse_error(start, "unterminated string (a string may not run over a line)");
         if (d != '\\') {
           s += d;
           continue;
@@ -80,33 +81,12 @@ token tokenizer::next() {
   return {token::kind::end, "", here()};
 }
 
-std::string read_scene_text(const std::string& path, const file_loc& from) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) throw parse_error(from, "'" + path + "' is a directory, not a scene file");
-  if (path.size() > 3 && path.compare(path.size() - 3, 3, ".gz") == 0) {
-    gzFile f = gzopen(path.c_str(), "rb");
-    if (!f) throw parse_error(from, "cannot open '" + path + "'");
-    std::string text;
-    char buffer[1 << 16];
-    while (true) {
-      const int n = gzread(f, buffer, sizeof buffer);
-      if (n < 0) {
-        gzclose(f);
-        throw parse_error(from, "'" + path + "': not a valid gzip file");
-      }
-      if (n == 0) break;
-      text.append(buffer, static_cast<std::size_t>(n));
-    }
-    const bool eof_ok = gzclose(f) == Z_OK;
-    if (!eof_ok) throw parse_error(from, "'" + path + "': truncated or corrupt gzip file");
-    return text;
+std::string read_scene_text(const std::string& path, const file_loc& from, std::uint64_t max_bytes) {
+  try {
+    return io::read_input_file(path, max_bytes);
+  } catch (const io::input_file_error& e) {
+    throw parse_error(from, "'" + quote_prefix(path, 200) + "': " + e.what());
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw parse_error(from, "cannot open '" + path + "'");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 }  // namespace mcrt::pbrt

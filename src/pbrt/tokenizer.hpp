@@ -32,10 +32,17 @@ class parse_error : public std::runtime_error {
 
   // The message with control characters written as escapes (\n, \t,
   // \xHH), so that text quoted from the file keeps it on one line.
+  // The message is cut at max_message bytes: every quote from a file is
+  // bounded already (quote_prefix), this only guards the line's length.
+  static constexpr std::size_t max_message = 1000;
   static std::string one_line(const std::string& s) {
     static const char hex[] = "0123456789abcdef";
     std::string out;
     for (const char c : s) {
+      if (out.size() >= max_message) {
+        out += "...";
+        break;
+      }
       const auto u = static_cast<unsigned char>(c);
       if (c == '\n') out += "\\n";
       else if (c == '\t') out += "\\t";
@@ -49,6 +56,16 @@ class parse_error : public std::runtime_error {
  private:
   file_loc loc_;
 };
+
+// Text quoted from a file in a message, at most `limit` bytes of it: a
+// 100,000-digit number or a megabyte-long word is shown by its beginning
+// and its length, so that an error stays one readable line.
+inline std::string quote_prefix(const std::string& s, std::size_t limit = 80) {
+  if (s.size() <= limit) return s;
+  std::size_t n = limit;
+  while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xc0) == 0x80) --n;  // not inside a UTF-8 character
+  return s.substr(0, n) + "... (" + std::to_string(s.size()) + " bytes)";
+}
 
 struct token {
   enum class kind { word, string, open_bracket, close_bracket, end };
@@ -83,7 +100,8 @@ class tokenizer {
 // The whole content of a scene file, decompressed where its name ends in
 // ".gz" (gzip, as pbrt-v4 reads .pbrt.gz files); throws parse_error at
 // `from` (the directive that names the file, or the command line's place)
-// when the file cannot be read.
-std::string read_scene_text(const std::string& path, const file_loc& from);
+// when the file cannot be read, is not a regular file, or holds (or
+// unpacks to) more than max_bytes bytes (input_file.hpp).
+std::string read_scene_text(const std::string& path, const file_loc& from, std::uint64_t max_bytes);
 
 }  // namespace mcrt::pbrt

@@ -212,6 +212,14 @@ class bvh {
     std::array<std::array<float, width>, 6> b;
     std::array<std::uint32_t, width> child;
     std::array<std::uint8_t, width> count;
+    // Bit i for each child the node has. The slab test alone would let a
+    // ray with a non-finite component (a NaN direction, an infinite origin:
+    // (inf - inf) * inv is NaN, which never narrows the interval) enter the
+    // empty boxes of the unused lanes too, whose child index 0 names the
+    // root: the traversal would push it again and again, past any stack.
+    // Masked, a node pushes at most its children but one, whatever the ray
+    // holds, and the stack bound of collapse_node holds for every ray.
+    std::uint8_t used = 0;
   };
   static_assert(sizeof(wide_node) == 32 * width);
 
@@ -280,9 +288,13 @@ class bvh {
       };
       std::array<aabb, bucket_count> bucket_box;
       std::array<std::uint32_t, bucket_count> bucket_n{};
+      // The bucket of a centroid; a NaN position (c1 - c0 overflows to
+      // infinity between centroids near -FLT_MAX and FLT_MAX, and inf / inf
+      // is NaN) goes to the first bucket: converting NaN or a value out of
+      // int's range to int is undefined, so the clamp is taken in float.
       const auto bucket_of = [&](std::uint32_t prim) {
-        const int b = static_cast<int>(bucket_count * ((centroids[prim][axis] - c0) / (c1 - c0)));
-        return std::clamp(b, 0, bucket_count - 1);
+        const float f = float(bucket_count) * ((centroids[prim][axis] - c0) / (c1 - c0));
+        return f >= 1.0f ? (f < float(bucket_count) ? static_cast<int>(f) : bucket_count - 1) : 0;
       };
       for (std::uint32_t i = begin; i < end; ++i) {
         const int b = bucket_of(order_[i]);
@@ -427,6 +439,7 @@ class bvh {
       }
       w.child[u] = child;
       w.count[u] = leaf_count;
+      if (i < n) w.used = static_cast<std::uint8_t>(w.used | (1u << i));
     }
     bound = static_cast<std::uint32_t>(n - 1) + below;
     return index;
@@ -553,7 +566,7 @@ class bvh {
       } else {
         const wide_node& w = wide_[e.child];
         std::array<float, width> t0;
-        unsigned mask = hits_boxes(w, rs, tmin, tmax, t0);
+        unsigned mask = hits_boxes(w, rs, tmin, tmax, t0) & w.used;
         if (mask != 0) {
           const auto child = [&](unsigned i) { return ask(entry{w.child[i], w.count[i], t0[i]}); };
           const entry a = child(static_cast<unsigned>(std::countr_zero(mask)));

@@ -19,6 +19,7 @@
 // serves every way of choosing.
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -123,6 +124,9 @@ class light_bvh {
     for (std::uint32_t i = 0; i < items.size(); ++i)
       if (items[i].phi > 0.0f && !items[i].box.empty()) ids.push_back(i);
     if (ids.empty()) return;
+    // Halving from this depth on adds at most bit_width(n) levels: the tree
+    // stays within max_depth for any count of lights.
+    halve_from_ = std::min<std::size_t>(max_depth - 24, max_depth - 1 - std::bit_width(ids.size()));
     nodes_.reserve(2 * ids.size());
     order_.reserve(ids.size());
     slots_.reserve(ids.size());
@@ -158,7 +162,8 @@ class light_bvh {
   }
 
   // The depth no tree exceeds (the traversals' stacks): past max_depth - 24
-  // a range is halved instead of split by cost, so 2^24 lights fit.
+  // a range is halved instead of split by cost (earlier for more than 2^23
+  // lights: halve_from_), so no tree is deeper.
   static constexpr std::size_t max_depth = 96;
 
   // What a selection needs of each light to weigh it against the others of
@@ -248,12 +253,15 @@ class light_bvh {
     constexpr int buckets = 12;
     float best_cost = std::numeric_limits<float>::infinity();
     int best_dim = -1, best_split = -1;
+    // The bucket of a centroid; NaN (hi - lo overflows for centroids near
+    // -FLT_MAX and FLT_MAX) goes to the first: converting NaN or an
+    // out-of-range value to int is undefined, so the clamp is taken in float.
     const auto bucket_of = [&](std::uint32_t id, int dim) {
       const float lo = centroids.lo[dim], hi = centroids.hi[dim];
-      const int b = static_cast<int>(buckets * ((items[id].box.centroid()[dim] - lo) / (hi - lo)));
-      return std::clamp(b, 0, buckets - 1);
+      const float f = float(buckets) * ((items[id].box.centroid()[dim] - lo) / (hi - lo));
+      return f >= 1.0f ? (f < float(buckets) ? static_cast<int>(f) : buckets - 1) : 0;
     };
-    for (int dim = 0; dim < 3 && depth + 24 < max_depth; ++dim) {
+    for (int dim = 0; dim < 3 && depth < halve_from_; ++dim) {
       if (!(centroids.hi[dim] > centroids.lo[dim])) continue;
       std::array<light_bounds, buckets> bk{};
       for (std::uint32_t i = begin; i < end; ++i) {
@@ -344,6 +352,7 @@ class light_bvh {
   }
 
   std::vector<node> nodes_;
+  std::size_t halve_from_ = max_depth - 24;  // the depth from which ranges are halved (the constructor)
   std::vector<std::uint32_t> order_;
   std::vector<std::uint32_t> leaf_of_;
   std::vector<slot> slots_;

@@ -21,7 +21,9 @@ struct aabb {
     hi = glm::max(hi, b.hi);
   }
   bool empty() const { return !(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z); }
-  vec3 centroid() const { return 0.5f * (lo + hi); }
+  // Halves first: lo + hi overflows to infinity for coordinates beyond
+  // FLT_MAX / 2, which are valid (a vertex at 3.4e38).
+  vec3 centroid() const { return 0.5f * lo + 0.5f * hi; }
   float surface_area() const {
     if (empty()) return 0.0f;
     const vec3 d = hi - lo;

@@ -98,8 +98,12 @@ class light_selection {
       }
       return;
     }
-    if (hierarchical && emitters.size() > 1)
-      throw std::logic_error("light_selection: bvh needs the scene's light tree (scene::build_light_tree)");
+    if (hierarchical && emitters.size() > 1) {
+      if (!tree) throw std::logic_error("light_selection: bvh needs the scene's light tree (scene::build_light_tree)");
+      // The tree holds the lights of positive flux; an empty one means that
+      // no light has any (every L or scale 0): nothing to choose, as by power.
+      return;
+    }
     for (std::size_t i = 0; i < emitters_.size(); ++i)
       if (faces((*lights_)[emitters_[i].light], o_)) {
         if (i < mask_bits) facing_ |= std::uint64_t{1} << i;

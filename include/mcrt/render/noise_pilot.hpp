@@ -81,6 +81,7 @@
 #include <variant>
 #include <vector>
 
+#include "mcrt/core/worker_errors.hpp"
 #include "mcrt/render/camera.hpp"
 #include "mcrt/render/renderer.hpp"
 #include "mcrt/sampling/auto_strategy.hpp"
@@ -534,9 +535,13 @@ noise_pilot_result estimate_image_variance_with(const Scene& sc, const camera& c
 
   const auto start = std::chrono::steady_clock::now();
   {
-    std::vector<std::jthread> pool;
-    for (unsigned t = 1; t < n; ++t) pool.emplace_back(worker);
-    worker();
+    worker_errors errors;  // an exception of a worker thread reaches the caller
+    {
+      std::vector<std::jthread> pool;
+      for (unsigned t = 1; t < n; ++t) pool.emplace_back([&] { errors.run(worker); });
+      errors.run(worker);
+    }
+    errors.rethrow_if_failed();
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   double sum = 0.0, weights = 0.0, albedo2 = 0.0, edge_sum = 0.0;
@@ -634,9 +639,13 @@ double sequence_noise_factor(const render_settings& rs, std::span<const edge_pix
   unsigned threads = rs.threads ? rs.threads : std::max(1u, std::thread::hardware_concurrency());
   if (pixels.size() * std::size_t(m) * std::size_t(n) < parallel_from) threads = 1;
   {
-    std::vector<std::jthread> pool;
-    for (unsigned t = 1; t < std::min(threads, 2u); ++t) pool.emplace_back(worker);
-    worker();
+    worker_errors errors;  // an exception of a worker thread reaches the caller
+    {
+      std::vector<std::jthread> pool;
+      for (unsigned t = 1; t < std::min(threads, 2u); ++t) pool.emplace_back([&] { errors.run(worker); });
+      errors.run(worker);
+    }
+    errors.rethrow_if_failed();
   }
   double between = 0.0, within = 0.0;
   for (std::size_t i = 0; i < pixels.size(); ++i) between += between_x[i], within += within_x[i];

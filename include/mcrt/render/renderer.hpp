@@ -23,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "mcrt/core/worker_errors.hpp"
 #include "mcrt/render/camera.hpp"
 #include "mcrt/render/image.hpp"
 #include "mcrt/render/path_tracer.hpp"
@@ -214,11 +215,12 @@ render_result render_with(const Scene& sc, const camera& cam, const render_setti
   std::mutex finished_mutex;
   std::condition_variable finished;
   std::atomic<std::uint64_t> nonfinite{0};
-  auto worker = [&] {
+  worker_errors errors;
+  auto work = [&] {
     std::uint64_t bad = 0;
     const float inv_w = 1.0f / static_cast<float>(rs.width), inv_h = 1.0f / static_cast<float>(rs.height);
     tile_footprints footprints;
-    for (int t; (t = next.fetch_add(1, std::memory_order_relaxed)) < tile_count;) {
+    for (int t; !errors.failed() && (t = next.fetch_add(1, std::memory_order_relaxed)) < tile_count;) {
       const int x0 = (t % tiles_x) * tile, y0 = (t / tiles_x) * tile;
       const int x1 = std::min(x0 + tile, rs.width), y1 = std::min(y0 + tile, rs.height);
       if (footprint) footprints.trace(sc, cam, rs.filter, x0, y0, x1, y1, inv_w, inv_h);
@@ -239,6 +241,15 @@ render_result render_with(const Scene& sc, const camera& cam, const render_setti
     }
     nonfinite.fetch_add(bad, std::memory_order_relaxed);
   };
+  // A worker that throws (std::bad_alloc, say) stops the others and wakes
+  // the progress reporter; its exception is rethrown below, after the join.
+  auto worker = [&] {
+    errors.run(work);
+    if (errors.failed()) {
+      const std::lock_guard<std::mutex> lock(finished_mutex);
+      finished.notify_all();
+    }
+  };
 
   const auto start = std::chrono::steady_clock::now();
   const auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
@@ -248,16 +259,17 @@ render_result render_with(const Scene& sc, const camera& cam, const render_setti
   if (progress) {
     // The calling thread reports progress while the pool works.
     pool.emplace_back(worker);
-    for (int d; (d = done.load(std::memory_order_acquire)) < tile_count;) {
+    for (int d; (d = done.load(std::memory_order_acquire)) < tile_count && !errors.failed();) {
       progress(static_cast<double>(d) / tile_count, elapsed());
       std::unique_lock<std::mutex> lock(finished_mutex);
       finished.wait_for(lock, progress_interval,
-                        [&] { return done.load(std::memory_order_acquire) == tile_count; });
+                        [&] { return done.load(std::memory_order_acquire) == tile_count || errors.failed(); });
     }
   } else {
     worker();
   }
   pool.clear();  // join
+  errors.rethrow_if_failed();
   out.seconds = elapsed();
   out.nonfinite_samples = nonfinite.load();
   if (progress) progress(1.0, out.seconds);
