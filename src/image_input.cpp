@@ -16,7 +16,7 @@ namespace {
 // errors with newlines: "Read error: hit end of file\nPNG read error: ...").
 std::string first_line(const std::string& s) {
   std::size_t a = s.find_first_not_of(" \t\r\n");
-  if (a == std::string::npos) return "no reason given";
+  if (a == std::string::npos) return "the decoder says no more (a truncated or corrupt file)";
   const std::size_t b = s.find_first_of("\r\n", a);
   return s.substr(a, b == std::string::npos ? std::string::npos : b - a);
 }

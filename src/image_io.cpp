@@ -25,10 +25,13 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
-// A name beside the target, unique to this process, keeping the extension.
+// A name beside the target, unique to this process, keeping the extension;
+// the target's stem and extension are cut so that the name stays within
+// the 255 bytes a file name may have (a 250-byte target's is too long).
 std::string temp_name(const std::string& path) {
   const fs::path p(path);
-  const std::string name = "." + p.stem().string() + ".tmp" + std::to_string(::getpid()) + p.extension().string();
+  const std::string stem = p.stem().string().substr(0, 100), ext = p.extension().string().substr(0, 20);
+  const std::string name = "." + stem + ".tmp" + std::to_string(::getpid()) + ext;
   return (p.parent_path() / name).string();
 }
 
@@ -57,13 +60,22 @@ image_format format_from_path(const std::string& path) {
   throw input_error(path + ": unknown output format '" + ext + "' (expected .exr, .png or .ppm)");
 }
 
-void check_writable(const std::string& path, bool needs_image_format) {
+void check_writable(const std::string& path, bool needs_image_format, const std::string& flag) {
+  if (path.empty()) throw input_error("an empty output path");
   if (needs_image_format) format_from_path(path);
   const fs::path p(path);
   const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw input_error(path + ": output directory '" + dir.string() + "' does not exist");
   if (fs::is_directory(p, ec)) throw input_error(path + ": is a directory");
+  // A name the file system cannot hold would fail only at the final rename,
+  // after the render.
+  const long name_max = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+  const std::size_t name_limit = name_max > 0 ? static_cast<std::size_t>(name_max) : 255;
+  if (p.filename().string().size() > name_limit)
+    throw input_error(flag + ": " + path.substr(0, 80) + "... (" + std::to_string(path.size()) +
+                      " bytes): the file name is longer than the " + std::to_string(name_limit) +
+                      " bytes the directory allows");
   // The output replaces its target by a rename: a device, a FIFO or a
   // socket there (-o /dev/null) would be replaced by a regular file.
   if (fs::exists(p, ec) && !fs::is_regular_file(p, ec))

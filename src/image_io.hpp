@@ -30,7 +30,8 @@ image_format format_from_path(const std::string& path);
 // Checks, before any work, that `path` can be written: a known extension,
 // an existing directory, and permission to create a file there (checked by
 // creating and removing a temporary file beside it; the target is untouched).
-void check_writable(const std::string& path, bool needs_image_format);
+// `flag` names the option in a message about a name too long to show.
+void check_writable(const std::string& path, bool needs_image_format, const std::string& flag = "--output");
 
 void write_image(const std::string& path, const image& img, const std::vector<image_attribute>& attributes);
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -137,7 +138,7 @@ int run_render(const render_options& opt) {
                              : !ls.output.empty() ? std::filesystem::path(ls.output).filename().string()
                                                   : ls.name + ".exr";
   check_writable(output, true);
-  if (!opt.stats.empty()) check_writable(opt.stats, false);
+  if (!opt.stats.empty()) check_writable(opt.stats, false, "--stats");
 
   render_settings rs;
   // The camera keeps the scene's aspect ratio: --width/--height change the
@@ -305,6 +306,36 @@ int run_diff(const diff_options& opt) {
   return 0;
 }
 
+// A message as one line on stderr: control characters (a newline or an
+// escape sequence in a file name or a value the user gave) written as
+// escapes, and at most 1000 bytes.
+std::string printable_line(const std::string& s) {
+  static const char hex[] = "0123456789abcdef";
+  std::string out;
+  for (const char c : s) {
+    if (out.size() >= 1000) {
+      out += "...";
+      break;
+    }
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '\n') out += "\\n";
+    else if (c == '\r') out += "\\r";
+    else if (c == '\t') out += "\\t";
+    else if (u < 0x20 || u == 0x7f) out += std::string("\\x") + hex[u >> 4] + hex[u & 15];
+    else out += c;
+  }
+  return out;
+}
+
+// Every option that takes a value was given a non-empty one (CLI11 takes
+// `--width ''` as no value at all, which would leave the default).
+void refuse_empty_values(const CLI::App& cmd) {
+  for (const CLI::Option* o : cmd.get_options())
+    if (o->get_expected_min() > 0)
+      for (const std::string& r : o->results())
+        if (r.empty()) throw input_error(o->get_name() + ": an empty value");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -322,7 +353,18 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--max-depth", ro.max_depth, "Maximum number of scattering events (overrides the scene)");
   render_cmd->add_option("--rr-depth", ro.rr_depth,
                          "Scattering events before Russian roulette starts (default 1; >= max depth: off)");
-  render_cmd->add_option("--seed", ro.seed, "Random seed (default 0)");
+  // A seed is a whole number in [0, 2^64 - 1] (CLI11 would wrap -1 round).
+  const CLI::Validator whole_number(
+      [](std::string& v) -> std::string {
+        std::uint64_t x = 0;
+        const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
+        return !v.empty() && v.find_first_not_of("0123456789") == std::string::npos && ec == std::errc() &&
+                       end == v.data() + v.size()
+                   ? std::string()
+                   : "must be a whole number in [0, 18446744073709551615]";
+      },
+      "UINT64");
+  render_cmd->add_option("--seed", ro.seed, "Random seed (default 0)")->check(whole_number);
   render_cmd->add_option("--threads", ro.threads, "Threads (default: all hardware threads)");
   render_cmd->add_option("--light-sampling", ro.light_sampling,
                          "Sample every light by area, solid-angle, projected-solid-angle (cosine-aware), "
@@ -379,13 +421,14 @@ int main(int argc, char** argv) {
   samples_cmd->add_option("--ellipse-map", sop.ellipse_map, "Map of the spherical ellipse (default parallel)")
       ->check(CLI::IsMember({"parallel", "polar"}));
   samples_cmd->add_option("--n", sop.n, "Number of samples (default 100000)");
-  samples_cmd->add_option("--seed", sop.seed, "Random seed (default 0)");
+  samples_cmd->add_option("--seed", sop.seed, "Random seed (default 0)")->check(whole_number);
   samples_cmd->add_option("-o,--output", sop.output, "CSV file (default: standard output)");
   samples_cmd->add_option("--max-input-size", sop.max_input_size, max_input_help);
 
   if (argc > 1 && argv[1][0] != '-' && std::string(argv[1]) != "render" && std::string(argv[1]) != "diff" &&
       std::string(argv[1]) != "samples") {
-    std::fprintf(stderr, "mcrt: unknown command '%s' (expected render, diff or samples; see mcrt --help)\n", argv[1]);
+    std::fprintf(stderr, "mcrt: unknown command '%s' (expected render, diff or samples; see mcrt --help)\n",
+                 printable_line(std::string(argv[1]).substr(0, 80)).c_str());
     return 2;
   }
   try {
@@ -399,10 +442,12 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     std::string msg = e.what();
     std::replace(msg.begin(), msg.end(), '\n', ' ');
-    std::fprintf(stderr, "mcrt: %s (see mcrt --help)\n", msg.c_str());
+    std::fprintf(stderr, "mcrt: %s (see mcrt --help)\n", printable_line(msg).c_str());
     return 2;
   }
   try {
+    for (const CLI::App* cmd : {render_cmd, samples_cmd, diff_cmd})
+      if (cmd->parsed()) refuse_empty_values(*cmd);
     if (render_cmd->parsed()) return run_render(ro);
     if (samples_cmd->parsed()) {
       sop.max_input_bytes =
@@ -411,10 +456,10 @@ int main(int argc, char** argv) {
     }
     return run_diff(dop);
   } catch (const input_error& e) {
-    std::fprintf(stderr, "mcrt: %s\n", e.what());
+    std::fprintf(stderr, "mcrt: %s\n", printable_line(e.what()).c_str());
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "mcrt: error: %s\n", e.what());
+    std::fprintf(stderr, "mcrt: error: %s\n", printable_line(e.what()).c_str());
     return 1;
   }
 }

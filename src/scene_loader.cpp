@@ -188,18 +188,27 @@ color non_negative_color(const reader& rd, const json& obj, const std::string& p
   return c;
 }
 
+// An albedo: the share of the light a surface reflects, in [0, 1] (more
+// would create energy, and a path's throughput would grow without bound).
+color albedo_color(const reader& rd, const json& obj, const std::string& path, const std::string& key) {
+  const color c = non_negative_color(rd, obj, path, key);
+  if (c.x > 1 || c.y > 1 || c.z > 1)
+    rd.ctx.fail(join(path, key), "components must be in [0, 1] (a surface reflects at most the light it receives)");
+  return c;
+}
+
 material read_material(const reader& rd, const json& m, const std::string& path) {
   if (!m.is_object()) rd.ctx.fail(path, std::string("expected an object, got ") + type_name(m));
   const std::string type = rd.string(m, path, "type");
   if (type == "lambertian") {
     rd.only(m, path, {"type", "albedo"});
-    return lambertian{non_negative_color(rd, m, path, "albedo")};
+    return lambertian{albedo_color(rd, m, path, "albedo")};
   }
   if (type == "metal") {
     rd.only(m, path, {"type", "albedo", "fuzz"});
     const double fuzz = rd.number_or(m, path, "fuzz", 0.0);
     if (fuzz < 0.0 || fuzz > 1.0) rd.ctx.fail(join(path, "fuzz"), "must be in [0, 1]");
-    return metal{non_negative_color(rd, m, path, "albedo"), static_cast<float>(fuzz)};
+    return metal{albedo_color(rd, m, path, "albedo"), static_cast<float>(fuzz)};
   }
   if (type == "dielectric") {
     rd.only(m, path, {"type", "ior"});

@@ -593,6 +593,11 @@ class builder {
                                  spectrum_use::unbounded);
         c.k = spectrum_texture(p, "k", *named_spectrum_rgb("metal-Cu-k", spectrum_use::unbounded, why),
                                spectrum_use::unbounded);
+        // A conductor's complex IOR eta + i k has eta >= 0 and k >= 0 (a
+        // texture below 0 is taken as 0 where it is evaluated).
+        for (const auto& [name, tex] : {std::pair{"eta", c.eta}, std::pair{"k", c.k}})
+          if (tex->is_constant() && glm::any(glm::lessThan(tex->value, color(0.0f))))
+            p.fail(*p.find(name), "must not be negative");
       }
       c.roughness = roughness(p);
       m = c;
@@ -628,6 +633,11 @@ class builder {
     r.u = p.find("uroughness") ? float_texture(p, "uroughness", 0.0f) : both;
     r.v = p.find("vroughness") ? float_texture(p, "vroughness", 0.0f) : both;
     r.remap = p.boolean("remaproughness", true);
+    // A roughness below 0 has no meaning (alpha is its square root); a
+    // texture below 0 is taken as 0 where it is evaluated.
+    for (const char* name : {"roughness", "uroughness", "vroughness"})
+      if (const param* q = p.find(name); q && q->type == "float" && q->numbers.size() == 1 && q->numbers[0] < 0.0)
+        p.fail(*q, "must be >= 0");
     return r;
   }
 

@@ -70,6 +70,11 @@ inline float fresnel_dielectric(float cos_theta_i, float eta) {
 // side is always the outside: cos_theta_i is clamped to [0, 1].
 inline float fresnel_complex(float cos_theta_i, std::complex<float> eta) {
   using complex = std::complex<float>;
+  // |eta| -> 0 and |eta| -> infinity both make a perfect mirror (R -> 1 at
+  // every angle); where |eta|^2 underflows or overflows single precision the
+  // equations below would divide 0 by 0 or infinity by infinity.
+  const float modulus2 = std::norm(eta);
+  if (!(modulus2 > 1e-30f && modulus2 < 1e30f)) return 1.0f;
   cos_theta_i = std::clamp(cos_theta_i, 0.0f, 1.0f);
   const float sin2_theta_i = 1.0f - sqr(cos_theta_i);
   const complex sin2_theta_t = sin2_theta_i / (eta * eta);

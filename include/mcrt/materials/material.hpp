@@ -86,7 +86,9 @@ inline bool diffuse_albedo(const material& m, const hit_record& rec, color& albe
     return true;
   }
   if (const auto* td = std::get_if<textured_diffuse>(&m)) {
-    albedo = td->reflectance.eval(rec.uv);
+    // pbrt-v4's DiffuseMaterial clamps its reflectance to [0, 1]: an image
+    // or a scale may give more (or less), which would not conserve energy.
+    albedo = glm::clamp(td->reflectance.eval(rec.uv), color(0.0f), color(1.0f));
     return true;
   }
   return false;

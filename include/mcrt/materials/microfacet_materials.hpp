@@ -21,7 +21,9 @@ struct microfacet_roughness {
   bool remap = true;
 
   trowbridge_reitz at(const hit_record& rec) const {
-    float au = u ? u->eval(rec.uv).r : 0.0f, av = v ? v->eval(rec.uv).r : 0.0f;
+    // A roughness texture below 0 (an image, a scale) is taken as 0:
+    // roughness_to_alpha is a square root.
+    float au = u ? std::max(u->eval(rec.uv).r, 0.0f) : 0.0f, av = v ? std::max(v->eval(rec.uv).r, 0.0f) : 0.0f;
     if (remap) {
       au = trowbridge_reitz::roughness_to_alpha(au);
       av = trowbridge_reitz::roughness_to_alpha(av);
@@ -47,8 +49,10 @@ struct conductor_material {
       b.eta = color(1.0f);
       b.k = 2.0f * glm::sqrt(r) / glm::sqrt(color(1.0f) - r);
     } else {
-      b.eta = eta->eval(rec.uv);
-      b.k = k->eval(rec.uv);
+      // An IOR texture below 0 (an image, a scale) is taken as 0: the
+      // conductor's eta and k are non-negative.
+      b.eta = glm::max(eta->eval(rec.uv), color(0.0f));
+      b.k = glm::max(k->eval(rec.uv), color(0.0f));
     }
     return b;
   }

@@ -7,6 +7,7 @@
 // texture is spectrum-valued (colour); a float texture is one whose three
 // channels are equal. The image's texels are decoded by whoever builds the
 // scene (the executable, through OpenImageIO): the library holds floats.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -55,16 +56,18 @@ struct texture {
       case kind::constant:
         return value;
       case kind::image: {
-        const vec2 st = mapping.map(uv);
+        const vec2 st = finite_or_zero(mapping.map(uv));
         // pbrt-v4 flips t so that v = 0 is the image's bottom row.
         color c = bilinear(st.x, 1.0f - st.y) * value;
         if (invert) c = glm::max(color(1.0f) - c, color(0.0f));
         return c;
       }
       case kind::checkerboard: {
-        const vec2 st = mapping.map(uv);
-        const bool even = ((static_cast<long long>(std::floor(st.x)) + static_cast<long long>(std::floor(st.y))) % 2) == 0;
-        return even ? a->eval(uv) : b->eval(uv);
+        const vec2 st = finite_or_zero(mapping.map(uv));
+        // The parity of floor(s) + floor(t), in float (a conversion to an
+        // integer would overflow beyond 2^63; floats beyond 2^24 are even).
+        const float parity = std::fmod(std::abs(std::floor(st.x)), 2.0f) + std::fmod(std::abs(std::floor(st.y)), 2.0f);
+        return parity != 1.0f ? a->eval(uv) : b->eval(uv);
       }
       case kind::scale:
         return a->eval(uv) * b->eval(uv);
@@ -91,10 +94,23 @@ struct texture {
     }
     return img->at(x, y);
   }
+  // Texture coordinates that the mapping made infinite or NaN (a uv or a
+  // uscale near 3.4e38) are taken as 0.
+  static vec2 finite_or_zero(vec2 st) {
+    return {std::isfinite(st.x) ? st.x : 0.0f, std::isfinite(st.y) ? st.y : 0.0f};
+  }
+  // A coordinate whose texel index would not fit an int, brought back into
+  // range with the same texels: by whole periods for repeat (s - floor(s)),
+  // to just outside the image for clamp and black.
+  float in_int_range(float s) const {
+    return wrap == texture_wrap::repeat ? s - std::floor(s) : std::clamp(s, -1.0f, 2.0f);
+  }
   // Bilinear interpolation of texel centres (pbrt-v4's Image::Bilerp:
   // texel (i, j) sits at ((i + 0.5) / w, (j + 0.5) / h)).
   color bilinear(float s, float t) const {
-    const float x = s * float(img->width) - 0.5f, y = t * float(img->height) - 0.5f;
+    float x = s * float(img->width) - 0.5f, y = t * float(img->height) - 0.5f;
+    if (!(std::abs(x) < 1e9f)) x = in_int_range(s) * float(img->width) - 0.5f;
+    if (!(std::abs(y) < 1e9f)) y = in_int_range(t) * float(img->height) - 0.5f;
     const float fx = std::floor(x), fy = std::floor(y);
     const int xi = static_cast<int>(fx), yi = static_cast<int>(fy);
     const float dx = x - fx, dy = y - fy;

@@ -29,7 +29,8 @@ namespace mcrt {
 class trowbridge_reitz {
  public:
   trowbridge_reitz() = default;
-  trowbridge_reitz(float alpha_x, float alpha_y) : alpha_x_(alpha_x), alpha_y_(alpha_y) {
+  trowbridge_reitz(float alpha_x, float alpha_y)
+      : alpha_x_(std::min(alpha_x, max_alpha)), alpha_y_(std::min(alpha_y, max_alpha)) {
     if (!effectively_smooth()) {
       // As pbrt-v4: if one direction has some roughness, the other cannot be
       // (nearly) 0, or x^2 / alpha_x^2 in D() blows up.
@@ -37,6 +38,12 @@ class trowbridge_reitz {
       alpha_y_ = std::max(alpha_y_, 1e-4f);
     }
   }
+
+  // The roughest surface: alpha is clamped to this (roughness 1e8). Its
+  // BSDFs reflect O(1/alpha) of the light, and for larger alpha D's
+  // denominator (alpha_x alpha_y s^2 for grazing microfacet normals)
+  // underflows single precision to NaN weights (seen at alpha 1e15).
+  static constexpr float max_alpha = 1e4f;
 
   float alpha_x() const { return alpha_x_; }
   float alpha_y() const { return alpha_y_; }
