@@ -560,6 +560,47 @@ TEST(BsdfTriplet, RoughDielectricSampleMatchesPdfAndEval) {
 
 // Delta lobes: pbrt-v4's conventions exactly. f |cos| / pdf is the lobe's
 // weight, eval() and pdf() are 0, the directions are the mirror and Snell's.
+// Extreme parameters a scene file may hold: every value the BSDFs return
+// stays finite. alpha beyond trowbridge_reitz::max_alpha (roughness 1e30:
+// D's denominator once underflowed to NaN weights) is clamped to it, and a
+// conductor's IOR of modulus near 0 or beyond 1e15 is a perfect mirror
+// (the limit of the Fresnel equations both ways).
+TEST(BsdfExtremes, RoughestSurfacesAndOddIorsStayFinite) {
+  EXPECT_EQ(trowbridge_reitz(1e15f, 1e15f).alpha_x(), trowbridge_reitz::max_alpha);
+  EXPECT_EQ(trowbridge_reitz(1e15f, 0.5f).alpha_y(), 0.5f);
+  for (const std::complex<float> eta : {std::complex<float>(0.0f, 0.0f), std::complex<float>(1e-30f, 0.0f),
+                                        std::complex<float>(0.0f, 1e-20f), std::complex<float>(1e20f, 0.0f),
+                                        std::complex<float>(3e38f, 3e38f)})
+    for (const float c : {1.0f, 0.5f, 1e-3f, 0.0f}) EXPECT_EQ(fresnel_complex(c, eta), 1.0f) << eta << " " << c;
+  // Just inside the guards the equations still hold: nearly a mirror.
+  EXPECT_GT(fresnel_complex(0.5f, std::complex<float>(1e-14f, 0.0f)), 0.999f);
+  EXPECT_GT(fresnel_complex(0.5f, std::complex<float>(9e14f, 0.0f)), 0.999f);
+  pcg32 rng(43, 1);
+  const conductor_bsdf metal{trowbridge_reitz(1e15f, 1e15f), gold_eta(), gold_k()};
+  const conductor_bsdf zero_ior{trowbridge_reitz(0.3f, 0.3f), color(0.0f), color(0.0f)};
+  const dielectric_bsdf glass{1.5f, trowbridge_reitz(1e15f, 1e15f)};
+  int sampled = 0;
+  for (const vec3& wo : outgoing_directions())
+    for (int i = 0; i < 2000; ++i) {
+      const float uc = rng.uniform();
+      const vec2 u = rng.uniform2();
+      const auto check = [&](const auto& b, const char* what) {
+        bsdf_sample s;
+        if (!b.sample(wo, uc, u, s)) return;
+        ++sampled;
+        ASSERT_TRUE(s.pdf > 0.0f && std::isfinite(s.pdf)) << what;
+        ASSERT_TRUE(all_finite(s.f)) << what;
+        ASSERT_TRUE(all_finite(s.f * std::abs(s.wi.z) / s.pdf)) << what;
+        ASSERT_TRUE(std::isfinite(b.pdf(wo, s.wi))) << what;
+        ASSERT_TRUE(all_finite(b.eval(wo, s.wi))) << what;
+      };
+      check(metal, "conductor, roughness 1e30");
+      check(zero_ior, "conductor, eta = k = 0");
+      check(glass, "dielectric, roughness 1e30");
+    }
+  EXPECT_GT(sampled, 10000);
+}
+
 TEST(BsdfTriplet, SmoothLobesAreDeltas) {
   const conductor_bsdf mirror = make_conductor(0.0f, 0.0f);
   EXPECT_TRUE(mirror.is_delta());

@@ -290,6 +290,14 @@ TEST_F(Cli, BadScenes) {
   expect_bad_scene(scene_with(floor, R"(, "odd": {"type": "plasma"})"), {"materials.odd.type", "plasma"});
   expect_bad_scene(scene_with(floor, R"(, "m": {"type": "metal", "albedo": [1, 1, 1], "fuzz": 2})"), {"materials.m.fuzz"});
   expect_bad_scene(scene_with(floor, R"(, "g": {"type": "dielectric", "ior": 0})"), {"materials.g.ior"});
+  // An albedo above 1 creates light (1e38 overflowed a path's throughput).
+  expect_bad_scene(scene_with(floor, R"(, "w": {"type": "lambertian", "albedo": [0.5, 1e38, 0.5]})"),
+                   {"materials.w.albedo", "[0, 1]"});
+  expect_bad_scene(scene_with(floor, R"(, "m": {"type": "metal", "albedo": [1.5, 1, 1], "fuzz": 0})"),
+                   {"materials.m.albedo", "[0, 1]"});
+  // Finite as a double, infinite as the float every value becomes.
+  expect_bad_scene(scene_with(floor + R"(, {"type": "sphere", "center": [0, 1e39, 0], "radius": 1, "material": "white"})"),
+                   {"objects[1].center", "single precision"});
   std::string big = scene_with(floor);
   big.replace(big.find("\"width\": 16"), 11, "\"width\": 99999");
   expect_bad_scene(big, {"camera.width", "16384"});

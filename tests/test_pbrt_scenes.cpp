@@ -415,6 +415,45 @@ TEST(PbrtManyLights, EverySelectionMatchesTheSumOfLambert) {
 // file) as the reflectance, looked up bilinearly with v flipped (pbrt-v4's
 // t = 1 - v), under a disk light; and a checkerboard of two constants. The
 // radiance at a floor point is the texture's value there times E / pi.
+// Texture coordinates a scene can drive to any float (a uv of 1e30, a
+// uscale of 1e38): lookups stay in the image (a texel index that does not
+// fit an int was undefined) and equal the lookup of the same place within
+// one period; non-finite coordinates are taken as 0.
+TEST(PbrtTextures, LookupsAtExtremeCoordinatesStayInTheImage) {
+  auto img = std::make_shared<texture_image>();
+  img->width = 4;
+  img->height = 2;
+  for (int i = 0; i < 8; ++i) img->texels.push_back(color(float(i)));
+  constexpr float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  for (const texture_wrap wrap : {texture_wrap::repeat, texture_wrap::clamp, texture_wrap::black}) {
+    texture t;
+    t.k = texture::kind::image;
+    t.img = img;
+    t.wrap = wrap;
+    for (const float u : {1e30f, -1e30f, 3e38f, -3e38f, 1e9f, inf, -inf, nan})
+      for (const float v : {0.3f, 1e30f, nan}) {
+        const color c = t.eval({u, v});
+        EXPECT_TRUE(all_finite(c)) << u << " " << v;
+        EXPECT_TRUE(c.r >= 0.0f && c.r <= 7.0f) << u << " " << v;
+      }
+    // Far out, a whole number of periods away: the texels of the first period.
+    if (wrap == texture_wrap::repeat) EXPECT_EQ(t.eval({1048576.0f + 0.375f, 0.25f}), t.eval({0.375f, 0.25f}));
+    if (wrap == texture_wrap::clamp) EXPECT_EQ(t.eval({1e30f, 0.25f}), t.eval({2.0f, 0.25f}));
+    if (wrap == texture_wrap::black) EXPECT_EQ(t.eval({-1e30f, 0.25f}), color(0.0f));
+    EXPECT_EQ(t.eval({nan, 0.25f}), t.eval({0.0f, 0.25f}));
+  }
+  // A checkerboard's parity where floor(s) is beyond any integer type.
+  texture ck;
+  ck.k = texture::kind::checkerboard;
+  ck.a = std::make_shared<texture>(texture::constant(color(1.0f)));
+  ck.b = std::make_shared<texture>(texture::constant(color(2.0f)));
+  EXPECT_EQ(ck.eval({1e30f, 0.5f}), color(1.0f));  // floats beyond 2^24 are even
+  EXPECT_EQ(ck.eval({1e30f, 1.5f}), color(2.0f));
+  EXPECT_EQ(ck.eval({-0.5f, 0.5f}), color(2.0f));  // floor: -1 + 0, odd
+  EXPECT_EQ(ck.eval({-0.5f, -0.5f}), color(1.0f));  // -1 - 1, even
+  EXPECT_EQ(ck.eval({inf, 0.5f}), ck.eval({0.0f, 0.5f}));
+}
+
 TEST(PbrtTextures, ImageAndCheckerboardReflectance) {
   const fs::path dir = scratch("textures");
   {
