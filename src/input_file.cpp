@@ -38,7 +38,10 @@ std::string too_large(std::uint64_t max_bytes) {
 std::uint64_t check_input_file(const std::string& path, std::uint64_t max_bytes) {
   std::error_code ec;
   const fs::file_status st = fs::status(path, ec);
-  if (ec || !fs::exists(st)) throw input_file_error("no such file");
+  // (A loop of symbolic links or a directory that may not be searched is
+  // an error of its own, not a missing file.)
+  if (ec && ec != std::errc::no_such_file_or_directory) throw input_file_error(ec.message());
+  if (!fs::exists(st)) throw input_file_error("no such file");
   if (fs::is_directory(st)) throw input_file_error("is a directory, not a file");
   if (!fs::is_regular_file(st)) {
     const char* kind = fs::is_character_file(st) || fs::is_block_file(st) ? "a device"
