@@ -1,6 +1,7 @@
 // The mcrt executable: `mcrt render`, `mcrt diff` and `mcrt samples` (docs/cli.md).
 #include <cmath>
 #include <CLI/CLI.hpp>
+#include <unistd.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -95,12 +96,38 @@ std::string strategy_summary(const loaded_scene& ls) {
   return first ? std::string(to_string(*first)) : "none";
 }
 
-void print_progress(double fraction, double elapsed) {
-  const double eta = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
-  std::fprintf(stderr, "\rrendering %5.1f%%  elapsed %7.1f s  ETA %7.1f s", 100.0 * fraction, elapsed, eta);
-  if (fraction >= 1.0) std::fputc('\n', stderr);
-  std::fflush(stderr);
-}
+// The progress display: on a terminal one line redrawn in place (every
+// report of the renderer, 4 a second); to a file or a pipe, where a redrawn
+// line would pile up as one long line, a line of its own at every tenth of
+// the image and at least every 30 s, and the last at the end.
+class progress_display {
+ public:
+  progress_display() : terminal_(::isatty(::fileno(stderr)) != 0) {}
+
+  void operator()(double fraction, double elapsed) {
+    const double eta = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
+    if (terminal_) {
+      std::fprintf(stderr, "\rrendering %5.1f%%  elapsed %7.1f s  ETA %7.1f s", 100.0 * fraction, elapsed, eta);
+      if (fraction >= 1.0) std::fputc('\n', stderr);
+      std::fflush(stderr);
+      return;
+    }
+    const int tenth = static_cast<int>(std::floor(10.0 * fraction + 1e-9));
+    const bool last = fraction >= 1.0;
+    if (done_ || (!last && tenth <= last_tenth_ && elapsed - last_seconds_ < 30.0)) return;
+    std::fprintf(stderr, "rendering %5.1f%%  elapsed %7.1f s  ETA %7.1f s\n", 100.0 * fraction, elapsed, eta);
+    std::fflush(stderr);
+    last_tenth_ = std::max(last_tenth_, tenth);
+    last_seconds_ = elapsed;
+    done_ = last;
+  }
+
+ private:
+  bool terminal_;
+  int last_tenth_ = 0;         // the last tenth of the image reported (0: none past the start)
+  double last_seconds_ = 0.0;  // when the last line was written
+  bool done_ = false;
+};
 
 int run_render(const render_options& opt) {
   check_range(opt.spp, "--spp", 1, max_spp);
@@ -198,7 +225,7 @@ int run_render(const render_options& opt) {
     noise->seconds += settle_seconds;
   }
 
-  render_result res = render_scene(ls.world, cam, rs, opt.quiet ? progress_callback{} : progress_callback(print_progress));
+  render_result res = render_scene(ls.world, cam, rs, opt.quiet ? progress_callback{} : progress_callback(progress_display{}));
   // The pilot and the set-up of the lights `auto` samples are part of the image's time.
   if (noise) res.seconds += noise->seconds;
   res.seconds += ls.auto_setup_seconds;

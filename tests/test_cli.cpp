@@ -167,6 +167,14 @@ TEST_F(Cli, ProgressGoesToStderrUnlessQuiet) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("100.0%"), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty());
+  // To a file (not a terminal): no carriage returns, a line per report of
+  // at most one per tenth of the image (and one per 30 s), ending at 100 %.
+  EXPECT_EQ(r.err.find('\r'), std::string::npos) << r.err;
+  const auto lines = std::count(r.err.begin(), r.err.end(), '\n');
+  EXPECT_GE(lines, 1);
+  EXPECT_LE(lines, 11) << r.err;
+  EXPECT_NE(r.err.rfind("rendering 100.0%"), std::string::npos);
+  EXPECT_EQ(r.err.back(), '\n');
 }
 
 // Every integrator with every sample generator: the same image for any
