@@ -10,7 +10,10 @@ Checks, and exits with status 1 listing every failure:
   3. every strategy name `mcrt render --light-sampling` accepts appears, in
      backticks, in docs/samplers.md;
   4. CITATION.cff is valid CFF 1.2 (with --cffconvert, the validator of the
-     Citation File Format's authors).
+     Citation File Format's authors);
+  5. every message in a string literal of src/, include/, tests/, scripts/
+     and bench/ that points to the documentation names a tracked Markdown
+     file and a section of it that exists (no bare "see README").
 
 Usage: docs_check.py --root SOURCE_DIR --mcrt PATH/TO/mcrt [--cffconvert PATH]
 """
@@ -106,6 +109,56 @@ def check_links(root: Path, files: set[str]) -> list[str]:
     return errors
 
 
+# A message's pointer into the documentation, inside a string literal of
+# the sources: "see README", "see docs/cli.md#input-files", a Markdown file
+# of the repository and perhaps its section.
+POINTER = re.compile(r"(?<![\w/.-])((?:[\w-]+/)*[\w-]+\.md)(#[\w-]+)?|\b(README)\b(?!\.md)")
+SEE = re.compile(r"\bsee\s+(?:the\s+)?(?=README|(?:[\w-]+/)*[\w-]+\.md)")
+STRING = {".cpp": re.compile(r'"(?:[^"\\\n]|\\.)*"'), ".hpp": re.compile(r'"(?:[^"\\\n]|\\.)*"'),
+          ".py": re.compile(r'"(?:[^"\\\n]|\\.)*"|\'(?:[^\'\\\n]|\\.)*\''),
+          ".sh": re.compile(r'"(?:[^"\\\n]|\\.)*"')}
+
+
+def check_message_pointers(root: Path, files: set[str]) -> list[str]:
+    """Every message that points to the documentation names a tracked
+    Markdown file and a section of it that exists (a bare "see README"
+    points nowhere in particular): any Markdown file named in a string
+    literal of the program (src/, include/), and anything after "see" in a
+    string literal of the tests, scripts and benchmarks (which also name the
+    Markdown files they write)."""
+    errors = []
+    for f in sorted(files):
+        ext = Path(f).suffix
+        program = f.startswith(("src/", "include/"))
+        if ext not in STRING or not (program or f.startswith(("tests/", "scripts/", "bench/"))):
+            continue
+        if f == "tests/docs_check.py":  # (its own docstrings quote the rule)
+            continue
+        text = (root / f).read_text(encoding="utf-8", errors="replace")
+        for lineno, line in enumerate(text.splitlines(), 1):
+            if line.strip().startswith(("//", "#")):
+                continue
+            for literal in STRING[ext].findall(line):
+                starts = [m.end() for m in SEE.finditer(literal)] if not program else None
+                for m in POINTER.finditer(literal):
+                    if starts is not None and m.start() not in starts:
+                        continue
+                    doc, fragment, bare = m.group(1), m.group(2), m.group(3)
+                    if bare:
+                        errors.append(f"{f}:{lineno}: a message points to the README without naming its section")
+                        continue
+                    # Relative to the source file's folder, the repository's root, or docs/.
+                    here = os.path.normpath(str(Path(f).parent / doc))
+                    path = next((c for c in (here, doc, "docs/" + doc) if c in files), None)
+                    if path is None:
+                        errors.append(f"{f}:{lineno}: a message points to {doc}, which is not a tracked file")
+                    elif not fragment:
+                        errors.append(f"{f}:{lineno}: a message points to {doc} without naming its section (#...)")
+                    elif fragment[1:] not in anchors((root / path).read_text(encoding="utf-8")):
+                        errors.append(f"{f}:{lineno}: a message points to {doc}{fragment}, a section {path} does not have")
+    return errors
+
+
 def help_text(mcrt: str, *args: str) -> str:
     r = subprocess.run([mcrt, *args, "--help"], capture_output=True, text=True)
     if r.returncode != 0:
@@ -148,8 +201,8 @@ def main() -> int:
     p.add_argument("--cffconvert")
     a = p.parse_args()
     files = tracked_files(a.root)
-    errors = (check_links(a.root, files) + check_flags(a.root, a.mcrt) + check_strategies(a.root, a.mcrt)
-              + check_citation(a.root, a.cffconvert))
+    errors = (check_links(a.root, files) + check_message_pointers(a.root, files) + check_flags(a.root, a.mcrt)
+              + check_strategies(a.root, a.mcrt) + check_citation(a.root, a.cffconvert))
     for e in errors:
         print(e)
     n_md = sum(f.endswith(".md") for f in files)

@@ -652,7 +652,8 @@ TEST_P(SphereArea, ChiSquare) {
   if (c.name == "very_close")
     GTEST_SKIP() << "observer almost on the sphere: float directions to 0.12 % of the visible cap (its grazing rim) "
                     "miss the sphere and get pdf 0, so the claimed density integrates to 0.9988 on the square "
-                    "(the histogram itself passes, p = 0.12); known limitation, see README";
+                    "(the histogram itself passes, p = 0.12); a known limitation, see "
+                    "docs/samplers.md#sphere_area_sampler--sphere_areahpp";
   const visible_sphere_cap cap = visible_sphere_cap::make(c.shape, c.o);
   ASSERT_TRUE(cap.valid);
   const dvec3 o(c.o);

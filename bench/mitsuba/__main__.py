@@ -62,7 +62,7 @@ def parse(argv):
     p.add_argument("--threads", type=int, default=2, help="threads of both renderers (default 2)")
     p.add_argument("--max-depth", type=int, help="mcrt max depth (default: the scene's); Mitsuba gets it + 1")
     p.add_argument("--xml", action="store_true", help="only write the Mitsuba XML of the scenes to OUT/xml")
-    g = p.add_argument_group("pbrt-v4 files (side-by-side comparison, see README.md)")
+    g = p.add_argument_group("pbrt-v4 files (side-by-side comparison, see README.md#pbrt-v4-files-side-by-side)")
     g.add_argument("--pbrt", action="append", metavar="FILE.pbrt",
                    help="render this pbrt-v4 file with mcrt and, translated, with Mitsuba; repeatable. "
                         "--size, --spp (one value), --max-depth (pbrt's maxdepth) override the file")
@@ -73,7 +73,8 @@ def parse(argv):
                         "llvm_ad_rgb is its fastest on a CPU)")
     g.add_argument("--reference", help="an EXR whose mean both images are compared with (e.g. TungstenRender.exr)")
     g.add_argument("--png-width", type=int, default=256, help="width of each of the PNG's three panels")
-    t = p.add_argument_group("throughput on a >= 1M-triangle mesh against Mitsuba's llvm_ad_rgb (see README.md)")
+    t = p.add_argument_group("throughput on a >= 1M-triangle mesh against Mitsuba's llvm_ad_rgb "
+                             "(see README.md#throughput-on-a-mesh-of-over-10⁶-triangles)")
     t.add_argument("--pbrt-throughput", action="store_true",
                    help="generate the mesh scene into OUT (default build/mitsuba-throughput) and measure "
                         "samples/s and efficiency of mcrt and Mitsuba llvm_ad_rgb (and scalar_rgb), interleaved")
