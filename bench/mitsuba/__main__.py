@@ -4,7 +4,7 @@
 
 Compares mcrt's efficiency, 1 / (MSE x render seconds), with Mitsuba 3's path
 tracer on the same scenes. Runs itself with .venv/bin/python (creating .venv
-with scripts/setup.sh if absent) and installs Mitsuba 3 there on first use
+with scripts/setup.sh --python if absent) and installs Mitsuba 3 there on first use
 (`pip install mitsuba`); Mitsuba is needed by this bench only.
 """
 import argparse
@@ -25,7 +25,7 @@ def bootstrap():
     py = VENV / "bin" / "python"
     if not py.exists():
         print("bench.mitsuba: no .venv, running scripts/setup.sh", file=sys.stderr)
-        subprocess.run(["bash", str(ROOT / "scripts" / "setup.sh")], check=True)
+        subprocess.run(["bash", str(ROOT / "scripts" / "setup.sh"), "--python"], check=True)
     if Path(sys.prefix).resolve() != VENV.resolve():
         env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])))
         os.execve(str(py), [str(py), "-m", "bench.mitsuba", *sys.argv[1:]], env)

@@ -14,7 +14,7 @@ alone, no process start, no I/O) and the error against a reference image
 markdown tables, plots and a report.
 
 Usage (from the repository root, with the virtual environment made by
-scripts/setup.sh)::
+scripts/setup.sh --python)::
 
     .venv/bin/python scripts/study.py                 # full study -> study-out/<UTC time>/
     .venv/bin/python scripts/study.py --quick         # a few minutes -> build/study-quick/

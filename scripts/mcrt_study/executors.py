@@ -171,7 +171,7 @@ def dask_pool(backend: Backend) -> Iterator[Pool]:
         from distributed import Client
     except ImportError as err:
         raise SystemExit(f"study.py: --backend dask needs the Python package distributed "
-                         f"(scripts/setup.sh installs it): {err}") from err
+                         f"(scripts/setup.sh --python installs it): {err}") from err
     client = Client(backend.scheduler, set_as_default=False)
     try:
         with pickled_by_value():

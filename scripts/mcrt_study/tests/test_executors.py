@@ -220,7 +220,7 @@ class SameRowsTest(ExecutorTestCase):
         self.check_against_sequential(rows3, settings3, csv3, expected, csv_text)
 
         if distributed is None:
-            self.skipTest("distributed is not installed (scripts/setup.sh installs it)")
+            self.skipTest("distributed is not installed (scripts/setup.sh --python installs it)")
         with distributed.LocalCluster(processes=False, n_workers=1, threads_per_worker=2,
                                       dashboard_address=None) as cluster:
             rows4, settings4, csv4 = self.study("dask", Backend("dask", 1, cluster.scheduler_address))
