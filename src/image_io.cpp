@@ -30,8 +30,13 @@ std::string lower_extension(const std::string& path) {
 // the 255 bytes a file name may have (a 250-byte target's is too long).
 std::string temp_name(const std::string& path) {
   const fs::path p(path);
-  const std::string stem = p.stem().string().substr(0, 100), ext = p.extension().string().substr(0, 20);
-  const std::string name = "." + stem + ".tmp" + std::to_string(::getpid()) + ext;
+  // (Appended piece by piece: GCC 12 at -O3 flags "." + stem + ... with a
+  // false -Wrestrict, GCC bug 105329.)
+  std::string name = ".";
+  name += p.stem().string().substr(0, 100);
+  name += ".tmp";
+  name += std::to_string(::getpid());
+  name += p.extension().string().substr(0, 20);
   return (p.parent_path() / name).string();
 }
 

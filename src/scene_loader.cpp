@@ -79,10 +79,13 @@ json parse_json(std::string text, const context& ctx) {
       // strtod: an overflowing literal gives +-HUGE_VAL (an underflowing
       // one 0, which JSON readers also take).
       const double v = std::strtod(token.c_str(), nullptr);
-      if (std::isinf(v))
-        marked += "\"" + std::string(overflow_marker) + "\"";
-      else
+      if (std::isinf(v)) {
+        marked += '"';
+        marked += overflow_marker;
+        marked += '"';
+      } else {
         marked += token;
+      }
       i = end;
       continue;
     }

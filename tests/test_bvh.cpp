@@ -299,7 +299,9 @@ TEST(Bvh, NonFiniteRaysAndExtremeBounds) {
         });
         for (std::size_t i = 0; i < visits.size(); ++i) ASSERT_LE(visits[i], 1) << "primitive visited twice, ray " << k;
         ASSERT_EQ(tree_i >= 0, brute_i >= 0) << "ray " << k;
-        if (brute_i >= 0) ASSERT_EQ(tree_t, brute_t) << "ray " << k;
+        if (brute_i >= 0) {
+          ASSERT_EQ(tree_t, brute_t) << "ray " << k;
+        }
         std::size_t leaf_visits = 0;
         tree.any(r, tmin, tmax0, [&](std::uint32_t, float, float) {
           ++leaf_visits;

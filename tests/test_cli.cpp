@@ -478,9 +478,10 @@ TEST_F(Cli, AutoIsReproducible) {
       lights.back().erase("rest_pilot_seconds");
       EXPECT_LT(lights.back()["gain_factor"].get<double>(), 1.0) << "kappa measured " << integrator;
       // R's weight kappa_R / kappa_l where kappa_l < kappa_R = 1/sqrt(8), else 1.
-      if (integrator == "mis")
+      if (integrator == "mis") {
         EXPECT_NEAR(lights.back()["rest_weight"].get<double>(),
                     std::max(1.0, 1.0 / std::sqrt(8.0) / lights.back()["gain_factor"].get<double>()), 1e-9);
+      }
       if (lights.size() > 1) {
         EXPECT_EQ(lights.back(), lights.front()) << integrator << " " << threads;
         const result r = run("diff " + out.string() + " " + (dir / (integrator + "0.exr")).string() + " --json");

@@ -156,7 +156,9 @@ TEST(LightBvh, Invariants) {
         const double t_child = std::acos(std::clamp(double(c->bounds.normals.cos_theta), -1.0, 1.0));
         const glm::dvec3 wc(c->bounds.normals.w), wp(nd.bounds.normals.w);
         const double d = std::atan2(glm::length(glm::cross(wc, wp)), glm::dot(wc, wp));
-        if (nd.bounds.normals.cos_theta > -1.0f) EXPECT_LE(d + t_child, t_parent + 1e-6) << "node " << i;
+        if (nd.bounds.normals.cos_theta > -1.0f) {
+          EXPECT_LE(d + t_child, t_parent + 1e-6) << "node " << i;
+        }
       }
     }
     EXPECT_LE(max_depth, light_bvh::max_depth);
@@ -191,7 +193,9 @@ TEST(LightImportance, PositiveWhereTheLightFacesThePoint) {
     ++facing;
     EXPECT_GT(bounds_importance(b, o, vec3(0.0f)), 0.0f) << k;
     const double x = exact_importance(l, s.emitters[k].power, o, n, true);
-    if (x >= 0.0) EXPECT_GT(x, 0.0) << "both sides of the horizon see a facing light, light " << k;
+    if (x >= 0.0) {
+      EXPECT_GT(x, 0.0) << "both sides of the horizon see a facing light, light " << k;
+    }
   }
   EXPECT_GT(facing, 50000);
 }
@@ -260,7 +264,9 @@ TEST(LightSelectionTree, ProbabilitiesAndDensitiesAgree) {
         // branch's share is then no choice (pick() returns -1), so the sum
         // is at most 1, and exactly 1 by power and uniformly.
         EXPECT_LE(total, 1.0 + 2e-5) << name(how) << " n " << n;
-        if (how == light_choice::power || how == light_choice::uniform) EXPECT_NEAR(total, 1.0, 2e-5) << name(how);
+        if (how == light_choice::power || how == light_choice::uniform) {
+          EXPECT_NEAR(total, 1.0, 2e-5) << name(how);
+        }
         if (k < 0) continue;
         EXPECT_EQ(prob, p[static_cast<std::size_t>(k)]) << name(how);
         // bvh's memo (filled by the calls above) changes no float: a fresh
@@ -323,7 +329,9 @@ TEST(LightSelectionTree, ChoosesWithTheStatedProbabilities) {
       for (int i = 0; i < samples; ++i) {
         float prob;
         const std::ptrdiff_t k = sel.pick(rng.uniform(), prob);
-        if (k >= 0) ASSERT_GT(p[static_cast<std::size_t>(k)], 0.0) << "a light of probability 0 was chosen";
+        if (k >= 0) {
+          ASSERT_GT(p[static_cast<std::size_t>(k)], 0.0) << "a light of probability 0 was chosen";
+        }
         ++counts[k < 0 ? static_cast<std::size_t>(n) : static_cast<std::size_t>(k)];
       }
       double chi2 = 0.0, pooled_e = 0.0, pooled_o = 0.0;

@@ -119,8 +119,9 @@ TEST(LightList, EveryStrategyAsTheVariant) {
   EXPECT_EQ(seen, list.size());
   for (std::size_t k = 0; k < list.size(); ++k) {
     EXPECT_EQ(list.get_if<triangle_area_sampler>(k) != nullptr, std::holds_alternative<triangle_area_sampler>(ref[k]));
-    if (!std::holds_alternative<rect_auto_sampler>(ref[k]))
+    if (!std::holds_alternative<rect_auto_sampler>(ref[k])) {
       EXPECT_THROW((void)list.get<rect_auto_sampler>(k), std::bad_variant_access);
+    }
   }
   EXPECT_THROW((void)list.at(list.size()), std::out_of_range);
 }

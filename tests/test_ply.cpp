@@ -43,12 +43,25 @@ std::string header(const std::string& format) {
 
 std::string ascii_ply() {
   std::string s = header("ascii");
-  for (int i = 0; i < 5; ++i)
-    s += std::to_string(xyz[i][0]) + " " + std::to_string(xyz[i][1]) + " " + std::to_string(xyz[i][2]) +
-         " 0 0 1 255 " + std::to_string(0.25f * float(i)) + " " + std::to_string(1.0f - 0.25f * float(i)) + "\n";
+  // (Appended piece by piece: GCC 12 flags to_string() + " " + ... with a
+  // false -Wrestrict, bug 105329.)
+  for (int i = 0; i < 5; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      s += std::to_string(xyz[i][c]);
+      s += ' ';
+    }
+    s += "0 0 1 255 ";
+    s += std::to_string(0.25f * float(i));
+    s += ' ';
+    s += std::to_string(1.0f - 0.25f * float(i));
+    s += '\n';
+  }
   for (const auto& f : faces) {
     s += std::to_string(f.size());
-    for (int v : f) s += " " + std::to_string(v);
+    for (int v : f) {
+      s += ' ';
+      s += std::to_string(v);
+    }
     s += " 7\n";
   }
   return s + "0 1\n";

@@ -487,11 +487,13 @@ class bvh {
     }
     // max(x, y) = x > y ? x : y, so a NaN in x leaves y; as a tree of two
     // levels (a NaN in y may then drop x too: the interval only widens, and
-    // no box the ray meets is lost).
-    const auto max = [](floatw x, floatw y) { return x > y ? x : y; };
-    const auto min = [](floatw x, floatw y) { return x < y ? x : y; };
-    const floatw lo = max(max(near[0], near[1]), max(near[2], floatw{} + tmin));
-    const floatw hi = min(min(far[0], far[1]), min(far[2], floatw{} + tmax));
+    // no box the ray meets is lost). Written out, not as functions of
+    // vectors: without AVX such a function's ABI differs (GCC's -Wpsabi).
+    const floatw tmin_w = floatw{} + tmin, tmax_w = floatw{} + tmax;
+    const floatw lo01 = near[0] > near[1] ? near[0] : near[1], lo2 = near[2] > tmin_w ? near[2] : tmin_w;
+    const floatw hi01 = far[0] < far[1] ? far[0] : far[1], hi2 = far[2] < tmax_w ? far[2] : tmax_w;
+    const floatw lo = lo01 > lo2 ? lo01 : lo2;
+    const floatw hi = hi01 < hi2 ? hi01 : hi2;
     std::memcpy(t0.data(), &lo, sizeof(floatw));
     const auto in = lo <= hi;
 #if defined(__AVX__)

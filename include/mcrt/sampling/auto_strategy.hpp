@@ -1135,15 +1135,19 @@ inline light_sampling choose_strategy(const sphere& s, const vec3& o, const vec3
 // a lookup per shading point instead of the rule's tens of ns).
 class tabulated_planar_rule {
  public:
+  // (Each rule is made in its shared storage at once: a temporary rule
+  // copied there would copy the variant of its exact sampler, which GCC 12
+  // at -O3 flags, falsely, as reading alternatives that are not there.)
   tabulated_planar_rule(const rect& r, const auto_params& p)
-      : tabulated_planar_rule(planar_rule(r, auto_costs::rect_for(p)), r.corner + 0.5f * (r.e1 + r.e2), 0.5f * r.e1,
-                              0.5f * r.e2, r.n, p) {}
+      : tabulated_planar_rule(std::make_shared<const planar_rule>(r, auto_costs::rect_for(p)),
+                              r.corner + 0.5f * (r.e1 + r.e2), 0.5f * r.e1, 0.5f * r.e2, r.n, p) {}
   tabulated_planar_rule(const ellipse& e, const auto_params& p)
-      : tabulated_planar_rule(planar_rule(e, auto_costs::ellipse_for(p)), e.center, e.a1, e.a2, e.n, p) {}
+      : tabulated_planar_rule(std::make_shared<const planar_rule>(e, auto_costs::ellipse_for(p)), e.center, e.a1,
+                              e.a2, e.n, p) {}
   // A triangle (its back side where `back`): the table in the frame of its
   // rectangle of the same covariance, without the symmetry.
   tabulated_planar_rule(const triangle& t, const auto_params& p, bool back)
-      : tabulated_planar_rule(planar_rule(t, back, auto_costs::triangle_for(p)), p) {}
+      : tabulated_planar_rule(std::make_shared<const planar_rule>(t, back, auto_costs::triangle_for(p)), p) {}
 
   light_sampling choose(const vec3& o, const vec3& n) const { return table_.lookup(o, n); }
 
@@ -1203,14 +1207,15 @@ class tabulated_planar_rule {
   }
 
  private:
-  tabulated_planar_rule(const planar_rule& rule, const vec3& c, const vec3& h1, const vec3& h2, const vec3& nl,
-                        const auto_params& p)
-      : rule_(std::make_shared<const planar_rule>(rule)), params_(p),
+  tabulated_planar_rule(std::shared_ptr<const planar_rule> rule, const vec3& c, const vec3& h1, const vec3& h2,
+                        const vec3& nl, const auto_params& p)
+      : rule_(std::move(rule)), params_(p),
         table_(c, h1, h2, nl, [r = rule_, p](const vec3& o, const vec3& n) { return r->choose(o, n, p); }) {}
-  tabulated_planar_rule(const planar_rule& rule, const auto_params& p)
-      : rule_(std::make_shared<const planar_rule>(rule)), params_(p),
-        table_(rule.centre(), rule.half_scale() * rule.axis1(), rule.half_scale() * rule.axis2(), rule.normal(),
-               [r = rule_, p](const vec3& o, const vec3& n) { return r->choose(o, n, p); }, rule.symmetric()) {}
+  tabulated_planar_rule(std::shared_ptr<const planar_rule> rule, const auto_params& p)
+      : rule_(std::move(rule)), params_(p),
+        table_(rule_->centre(), rule_->half_scale() * rule_->axis1(), rule_->half_scale() * rule_->axis2(),
+               rule_->normal(), [r = rule_, p](const vec3& o, const vec3& n) { return r->choose(o, n, p); },
+               rule_->symmetric()) {}
   // One rule, immutable, shared by the table's cells (which fill from it
   // lazily) and by copies of this: a light's variant holds a pointer, not
   // the rule's 680 bytes twice.
