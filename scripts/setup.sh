@@ -14,7 +14,7 @@ for a in "$@"; do
   esac
 done
 
-packages=(cmake g++ make pkg-config libglm-dev libopenimageio-dev nlohmann-json3-dev libcli11-dev
+packages=(cmake g++ make ninja-build pkg-config libglm-dev libopenimageio-dev nlohmann-json3-dev libcli11-dev
           libgtest-dev libbenchmark-dev libboost-math-dev zlib1g-dev python3 python3-venv)
 missing=()
 for p in "${packages[@]}"; do

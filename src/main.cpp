@@ -15,6 +15,7 @@
 #include <optional>
 #include <string>
 
+#include "auto_pilot.hpp"
 #include "image_io.hpp"
 #include "render_instances.hpp"
 #include "samples_command.hpp"
@@ -202,14 +203,11 @@ int run_render(const render_options& opt) {
   // kappa_E, and the lights' settling.
   double noise_seconds = 0.0, emission_seconds = 0.0, settle_seconds = 0.0;
   if (pilot && ls.auto_lights > 0) {
-    noise = estimate_image_variance(ls.world, cam, rs, noise_pilot_for(rs.width, rs.height, rs.spp));
-    noise_seconds = noise->seconds;
-    // The emission term with the image's own samples (render/noise_pilot.hpp).
-    const auto start = std::chrono::steady_clock::now();
-    edge_factor = edge_noise_factor(ls.world, cam, rs, noise->edge_pixels);
-    scale_emission_term(*noise, edge_factor);
-    emission_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    noise->seconds += emission_seconds;
+    image_noise pilot_noise = measure_image_noise(ls.world, cam, rs);
+    noise = std::move(pilot_noise.noise);
+    edge_factor = pilot_noise.edge_factor;
+    noise_seconds = pilot_noise.noise_seconds;
+    emission_seconds = pilot_noise.emission_seconds;
     // A noise-free pilot leaves nothing for a cheaper strategy to hide in.
     ap.image_variance = std::max(static_cast<float>(noise->image_variance), std::numeric_limits<float>::min());
     ap.albedo = static_cast<float>(std::sqrt(noise->mean_albedo2));
@@ -217,8 +215,7 @@ int run_render(const render_options& opt) {
     // Each light's rule at the fixed point of the image's noise and time
     // its choice makes, and the gate of its choice (render/choice_gain_pilot.hpp).
     const auto settle_start = std::chrono::steady_clock::now();
-    settlements = settle_auto_lights(ls.world, cam, rs, *noise, choice_gain_pixels_for(rs.width, rs.height),
-                                     !opt.auto_rest_cost);
+    settlements = settle_lights(ls.world, cam, rs, *noise, !opt.auto_rest_cost);
     for (const auto_light_settlement& a : settlements)
       if (a.cheapest) ls.auto_cheapest_lights.push_back(static_cast<std::uint32_t>(a.light));
     settle_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - settle_start).count();

@@ -1,0 +1,1 @@
+// The unit that precompiles mcrt/mcrt.hpp for the executable (src/CMakeLists.txt).
