@@ -261,6 +261,32 @@ AttributeEnd
   }
 }
 
+// A diffusetransmission floor (reflectance 0.3, transmittance 0.6) under
+// the nested triangle: seen from above it reflects R / pi times the
+// irradiance Lambert's formula gives, seen from below it transmits T / pi
+// times the same irradiance (one scattering event, direct light only).
+TEST_P(PbrtFloor, DiffuseTransmissionReflectsAndTransmitsLambert) {
+  std::string text = floor_scene(with(nested_triangle, ""));
+  const std::string diffuse = "Material \"diffuse\" \"rgb reflectance\" [ 0.5 0.5 0.5 ]";
+  text.replace(text.find(diffuse), diffuse.size(),
+               "Material \"diffusetransmission\" \"rgb reflectance\" [ 0.3 0.3 0.3 ] "
+               "\"rgb transmittance\" [ 0.6 0.6 0.6 ]");
+  const pbrt::built_scene b = from_text(text);
+  const std::vector<glm::dvec3> poly = light_triangles(b.world).at(0);
+  int id = 400;
+  for (const auto& [x, z] : floor_points) {
+    const double E = test::polygon_irradiance({x, 0.0, z}, {0.0, 1.0, 0.0}, poly, emit);
+    const test::estimate above = test::radiance_along(b.world, ray{{x, 0.5f, z}, {0, -1, 0}}, path_settings{1, 3},
+                                                      GetParam(), sampler_kind::sobol, 32, 4096, id, 7 + id);
+    ++id;
+    const test::estimate below = test::radiance_along(b.world, ray{{x, -0.5f, z}, {0, 1, 0}}, path_settings{1, 3},
+                                                      GetParam(), sampler_kind::sobol, 32, 4096, id, 7 + id);
+    ++id;
+    check(above, 0.3 / std::numbers::pi * E, "diffusetransmission from above");
+    check(below, 0.6 / std::numbers::pi * E, "diffusetransmission from below");
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(All, PbrtFloor, ::testing::Values(integrator_kind::mixture, integrator_kind::nee, integrator_kind::mis),
                          integrator_name);
 

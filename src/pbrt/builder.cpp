@@ -8,7 +8,10 @@
 #include <set>
 #include <sstream>
 
+#include "pbrt/materials.hpp"
+#include "pbrt/params.hpp"
 #include "pbrt/ply.hpp"
+#include "pbrt/values.hpp"
 #include "pbrt/spectrum.hpp"
 
 namespace mcrt::pbrt {
@@ -16,125 +19,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A name or value from the file in a message (bounded: tokenizer.hpp).
-// (Appended piece by piece: GCC 12 at -O3 flags "\"" + s + "\"" with a
-// false -Wrestrict, GCC bug 105329.)
-std::string quoted(const std::string& s) {
-  std::string out;
-  out.reserve(s.size() + 2);
-  out += '"';
-  out += quote_prefix(s, 200);
-  out += '"';
-  return out;
-}
-
 // The command line's limits (docs/cli.md), for what a file asks for.
 constexpr int max_samples_per_pixel = 1 << 20;
 constexpr int max_path_depth = 100000;
 
-
-[[noreturn]] void refuse(const file_loc& loc, const std::string& what) { throw parse_error(loc, what); }
-
-// A directive's parameters as one shape, material, texture ... reads them:
-// each lookup marks the parameter used, and finish() refuses any the
-// directive gave that nothing used (nothing is silently ignored). Attribute
-// defaults of the directive's kind are looked up after its own parameters.
-class params {
- public:
-  params(const directive& d, const std::vector<param>* defaults = nullptr)
-      : d_(d), defaults_(defaults), what_(d.name + (d.type.empty() ? "" : " " + quoted(d.type))) {}
-
-  const std::string& what() const { return what_; }
-  const file_loc& loc() const { return d_.loc; }
-
-  const param* find(const std::string& name) {
-    for (const param& p : d_.params)
-      if (p.name == name) {
-        used_.insert(&p);
-        return &p;
-      }
-    if (defaults_)
-      for (const param& p : *defaults_)
-        if (p.name == name) return &p;
-    return nullptr;
-  }
-
-  [[noreturn]] void fail(const param& p, const std::string& reason) const {
-    refuse(p.loc, what_ + ": " + quoted(p.type + " " + p.name) + " " + reason);
-  }
-  [[noreturn]] void fail(const std::string& reason) const { refuse(d_.loc, what_ + ": " + reason); }
-
-  void expect_type(const param& p, std::initializer_list<const char*> types) const {
-    for (const char* t : types)
-      if (p.type == t) return;
-    std::string list;
-    for (const char* t : types) list += (list.empty() ? "" : " or ") + std::string(t);
-    fail(p, "must be of type " + list);
-  }
-
-  std::optional<double> number(const std::string& name, std::initializer_list<const char*> types = {"float"}) {
-    const param* p = find(name);
-    if (!p) return std::nullopt;
-    expect_type(*p, types);
-    if (p->numbers.size() != 1) fail(*p, "must have one value, has " + std::to_string(p->size()));
-    return p->numbers[0];
-  }
-  double real(const std::string& name, double def) { return number(name).value_or(def); }
-  int integer(const std::string& name, int def) {
-    const std::optional<double> v = number(name, {"integer"});
-    if (!v) return def;
-    if (*v != std::floor(*v) || std::abs(*v) > 2e9) fail(*find(name), "must be an integer");
-    return static_cast<int>(*v);
-  }
-  bool boolean(const std::string& name, bool def) {
-    const param* p = find(name);
-    if (!p) return def;
-    expect_type(*p, {"bool"});
-    if (p->bools.size() != 1) fail(*p, "must have one value");
-    return p->bools[0];
-  }
-  std::optional<std::string> string(const std::string& name) {
-    const param* p = find(name);
-    if (!p) return std::nullopt;
-    expect_type(*p, {"string"});
-    if (p->strings.size() != 1) fail(*p, "must have one value");
-    return p->strings[0];
-  }
-  std::vector<double> numbers(const std::string& name, std::initializer_list<const char*> types, std::size_t group) {
-    const param* p = find(name);
-    if (!p) return {};
-    expect_type(*p, types);
-    if (p->numbers.size() % group != 0)
-      fail(*p, "must have a multiple of " + std::to_string(group) + " values, has " + std::to_string(p->numbers.size()));
-    return p->numbers;
-  }
-
-  // A parameter mcrt does not implement is accepted at pbrt-v4's default
-  // value only (where it does not change the image).
-  void accept_default(const std::string& name, double def) {
-    const param* p = find(name);
-    if (p && !(p->numbers.size() == 1 && p->numbers[0] == def))
-      fail(*p, "is not supported except at its default " + std::to_string(def));
-  }
-  void accept_default_string(const std::string& name, const std::string& def) {
-    const param* p = find(name);
-    if (p && !(p->strings.size() == 1 && p->strings[0] == def)) fail(*p, "is not supported except at its default " + quoted(def));
-  }
-  // Parameters that do not change the expected image (render options).
-  void accept_any(const std::string& name) { find(name); }
-
-  // Refuses what the directive gave and nothing used.
-  void finish() const {
-    for (const param& p : d_.params)
-      if (!used_.count(&p)) fail(p, "is not supported");
-  }
-
- private:
-  const directive& d_;
-  const std::vector<param>* defaults_;
-  std::string what_;
-  std::set<const param*> used_;
-};
 
 // What pbrt-v4's graphics state holds that mcrt uses.
 struct graphics_state {
@@ -150,12 +38,6 @@ struct graphics_state {
   };
   std::optional<area_light> light;
   std::map<std::string, std::vector<param>> attribute_defaults;  // "shape", "light", "material", ...
-};
-
-// A texture in the file: spectrum or float, by name.
-struct texture_entry {
-  std::shared_ptr<const texture> tex;
-  bool is_float = false;
 };
 
 class builder {
@@ -190,7 +72,7 @@ class builder {
   std::vector<std::pair<graphics_state, bool>> stack_;  // saved states; true: only the transform (TransformBegin)
   std::map<std::string, transform> coordinate_systems_;
   std::map<std::string, std::uint32_t> named_materials_;
-  std::map<std::string, texture_entry> spectrum_textures_, float_textures_;
+  values values_;  // spectra, and the file's textures by name
   bool saw_world_ = false, saw_camera_ = false;
   file_loc camera_loc_;  // the Camera directive's place
 
@@ -441,56 +323,6 @@ class builder {
 
   // ---- spectra, textures, materials ----------------------------------------
 
-  // A spectrum-valued parameter as linear sRGB: rgb as it is, blackbody
-  // normalised to luminance 1 (spectrum.hpp), spectrum values by their
-  // conversion there.
-  std::optional<color> spectrum(params& p, const std::string& name, spectrum_use use) {
-    const param* q = p.find(name);
-    if (!q) return std::nullopt;
-    if (q->type == "rgb" || q->type == "color") {
-      const color c(float(q->numbers[0]), float(q->numbers[1]), float(q->numbers[2]));
-      if (use != spectrum_use::unbounded && (c.r < 0.0f || c.g < 0.0f || c.b < 0.0f)) p.fail(*q, "must not be negative");
-      return c;
-    }
-    if (q->type == "blackbody") {
-      if (q->numbers.size() != 1 || !(q->numbers[0] > 0.0)) p.fail(*q, "must be one temperature > 0 (kelvin)");
-      return blackbody_rgb(q->numbers[0]);
-    }
-    if (q->type == "spectrum") {
-      std::string why;
-      const std::optional<color> c = q->strings.empty() ? sampled_spectrum_rgb(q->numbers, use, why)
-                                                        : named_spectrum_rgb(q->strings[0], use, why);
-      if (!c) p.fail(*q, why);
-      return c;
-    }
-    p.fail(*q, "must be of type rgb, blackbody or spectrum");
-  }
-
-  // A material parameter that may be a texture: its texture, or a constant
-  // one from the value (def where the parameter is absent).
-  std::shared_ptr<const texture> spectrum_texture(params& p, const std::string& name, const color& def,
-                                                  spectrum_use use = spectrum_use::albedo) {
-    const param* q = p.find(name);
-    if (q && q->type == "texture") {
-      const auto it = spectrum_textures_.find(q->strings.at(0));
-      if (it != spectrum_textures_.end()) return it->second.tex;
-      const auto fit = float_textures_.find(q->strings.at(0));
-      if (fit != float_textures_.end()) return fit->second.tex;  // a float texture as a grey spectrum
-      p.fail(*q, "names no texture " + quoted(q->strings.at(0)));
-    }
-    return std::make_shared<texture>(texture::constant(spectrum(p, name, use).value_or(def)));
-  }
-  std::shared_ptr<const texture> float_texture(params& p, const std::string& name, float def) {
-    const param* q = p.find(name);
-    if (q && q->type == "texture") {
-      const auto it = float_textures_.find(q->strings.at(0));
-      if (it == float_textures_.end()) p.fail(*q, "names no float texture " + quoted(q->strings.at(0)));
-      return it->second.tex;
-    }
-    const float v = static_cast<float>(p.real(name, def));
-    return std::make_shared<texture>(texture::constant(color(v)));
-  }
-
   void texture_directive(const directive& d) {
     const std::string& name = d.strings[0];
     const std::string& type = d.strings[1];
@@ -507,14 +339,14 @@ class builder {
                     float(p.real("vdelta", 0.0))};
     };
     const auto value = [&](const std::string& pname, float def) {
-      return is_float ? float_texture(p, pname, def) : spectrum_texture(p, pname, color(def));
+      return is_float ? values_.float_texture(p, pname, def) : values_.spectrum_texture(p, pname, color(def));
     };
     if (cls == "constant") {
       t = std::make_shared<texture>(*value("value", 1.0f));
     } else if (cls == "scale") {
       t->k = texture::kind::scale;
       t->a = value("tex", 1.0f);
-      t->b = float_texture(p, "scale", 1.0f);
+      t->b = values_.float_texture(p, "scale", 1.0f);
     } else if (cls == "checkerboard") {
       t->k = texture::kind::checkerboard;
       mapping();
@@ -567,7 +399,7 @@ class builder {
                         ": not supported (supported: imagemap, constant, scale, checkerboard)");
     }
     p.finish();
-    (is_float ? float_textures_ : spectrum_textures_)[name] = {t, is_float};
+    (is_float ? values_.float_textures : values_.spectrum_textures)[name] = {t, is_float};
   }
 
   const std::vector<param>* attribute_defaults(const std::string& kind) const {
@@ -582,72 +414,10 @@ class builder {
     if (d.name == "MakeNamedMaterial") p.string("type");
     if (p.find("displacement")) p.fail(*p.find("displacement"), "is not supported");
     if (p.find("normalmap")) p.fail(*p.find("normalmap"), "is not supported");
-    mcrt::material m;
-    if (type == "diffuse") {
-      const std::shared_ptr<const texture> r = spectrum_texture(p, "reflectance", color(0.5f));
-      if (r->is_constant())
-        m = lambertian{glm::clamp(r->value, color(0.0f), color(1.0f))};
-      else
-        m = textured_diffuse{*r};
-    } else if (type == "conductor") {
-      conductor_material c;
-      const bool has_ior = p.find("eta") || p.find("k");
-      if (p.find("reflectance")) {
-        if (has_ior) p.fail("gives both reflectance and eta/k (pbrt-v4 refuses that too)");
-        c.reflectance = spectrum_texture(p, "reflectance", color(0.0f));
-      } else {
-        // pbrt-v4's default conductor is copper.
-        std::string why;
-        c.eta = spectrum_texture(p, "eta", *named_spectrum_rgb("metal-Cu-eta", spectrum_use::unbounded, why),
-                                 spectrum_use::unbounded);
-        c.k = spectrum_texture(p, "k", *named_spectrum_rgb("metal-Cu-k", spectrum_use::unbounded, why),
-                               spectrum_use::unbounded);
-        // A conductor's complex IOR eta + i k has eta >= 0 and k >= 0 (a
-        // texture below 0 is taken as 0 where it is evaluated).
-        for (const auto& [name, tex] : {std::pair{"eta", c.eta}, std::pair{"k", c.k}})
-          if (tex->is_constant() && glm::any(glm::lessThan(tex->value, color(0.0f))))
-            p.fail(*p.find(name), "must not be negative");
-      }
-      c.roughness = roughness(p);
-      m = c;
-    } else if (type == "dielectric") {
-      dielectric_material g;
-      if (const param* e = p.find("eta")) {
-        if (e->type == "float") {
-          g.eta = static_cast<float>(p.real("eta", 1.5));
-        } else if (e->type == "spectrum") {
-          // One IOR for the three channels: a named glass's at 550 nm, a
-          // sampled spectrum's at 532 nm (mcrt renders no dispersion).
-          g.eta = spectrum(p, "eta", spectrum_use::unbounded)->g;
-        } else {
-          p.fail(*e, "must be a float or a spectrum (textured IORs are not supported)");
-        }
-        if (!(g.eta > 0.0f) || !std::isfinite(g.eta)) p.fail(*e, "must be > 0");
-      }
-      g.roughness = roughness(p);
-      m = g;
-    } else {
-      refuse(d.loc, d.name + " " + quoted(type) + ": not supported (supported: diffuse, conductor, dielectric)");
-    }
+    const mcrt::material m = make_material(d.name, type, p, values_);
     p.finish();
     out_.world.materials.push_back(m);
     return static_cast<std::uint32_t>(out_.world.materials.size() - 1);
-  }
-
-  // pbrt-v4's roughness parameters: uroughness and vroughness, each
-  // `roughness` (default 0) where absent; remaproughness (default true).
-  microfacet_roughness roughness(params& p) {
-    microfacet_roughness r;
-    const std::shared_ptr<const texture> both = float_texture(p, "roughness", 0.0f);
-    r.u = p.find("uroughness") ? float_texture(p, "uroughness", 0.0f) : both;
-    r.v = p.find("vroughness") ? float_texture(p, "vroughness", 0.0f) : both;
-    r.remap = p.boolean("remaproughness", true);
-    // A roughness below 0 has no meaning (alpha is its square root); a
-    // texture below 0 is taken as 0 where it is evaluated.
-    for (const char* name : {"roughness", "uroughness", "vroughness"})
-      if (const param* q = p.find(name); q && q->type == "float" && q->numbers.size() == 1 && q->numbers[0] < 0.0)
-        p.fail(*q, "must be >= 0");
-    return r;
   }
 
   void area_light(const directive& d) {
@@ -659,7 +429,7 @@ class builder {
     // of luminance 1 here), scale divided by L's luminance (an rgb L is
     // taken as it is: mcrt renders in RGB, pbrt-v4 divides by its
     // illuminant's luminance only).
-    color L = spectrum(p, "L", spectrum_use::illuminant).value_or(color(1.0f));
+    color L = values_.spectrum(p, "L", spectrum_use::illuminant).value_or(color(1.0f));
     const float scale = static_cast<float>(p.real("scale", 1.0));
     // A negative scale would make a light of negative power, which no
     // light selection can choose by (pbrt-v4 does not check it either).

@@ -530,6 +530,20 @@ def lights() -> list[Case]:
                     "reflectance-1e38": "1e38 1e38 1e38"}.items():
         mat(f"diffuse-{name}", f'Material "diffuse" "rgb reflectance" [ {v} ]')
         mat(f"conductor-{name}", f'Material "conductor" "rgb reflectance" [ {v} ]')
+    # diffusetransmission: defaults, scale at the extremes (clamped at the hit
+    # as pbrt-v4 clamps it), values beyond 1, a textured transmittance; and
+    # what must be refused.
+    for name, params in {"default": "", "scale-1e30": '"float scale" 1e30', "scale-neg": '"float scale" -1',
+                         "scale-0": '"float scale" 0', "t-2": '"rgb transmittance" [ 2 2 2 ]',
+                         "white": '"rgb reflectance" [ 1 1 1 ] "rgb transmittance" [ 1 1 1 ]',
+                         "t-checker": '"texture transmittance" "checks"'}.items():
+        pre = ('Texture "checks" "spectrum" "checkerboard" "float uscale" 1e30 "rgb tex1" [ 1 1 1 ] '
+               '"rgb tex2" [ 0 0 0 ]\n') if "checker" in name else ""
+        mat(f"diffusetransmission-{name}", pre + f'Material "diffusetransmission" {params}', expect=RENDERED)
+    for name, params in {"r-neg": '"rgb reflectance" [ -1 -1 -1 ]', "scale-string": '"string scale" "x"',
+                         "unknown-param": '"float sigma" 1', "t-no-texture": '"texture transmittance" "nope"',
+                         "scale-1e39": '"float scale" 1e39'}.items():
+        mat(f"diffusetransmission-{name}", f'Material "diffusetransmission" {params}', expect=REFUSED)
     mat("unknown-material", 'Material "coateddiffuse"', note="an unsupported material")
     mat("named-undefined", 'NamedMaterial "nope"', note="NamedMaterial of nothing")
     mat("makenamed-no-type", 'MakeNamedMaterial "m"\nNamedMaterial "m"', note="MakeNamedMaterial without a type")

@@ -3,11 +3,13 @@
 // bsdf_sample.hpp): Lambertian, conductor (smooth mirror or rough
 // Torrance-Sparrow), dielectric (smooth or rough, reflection and
 // transmission) and thin dielectric, with the Fresnel terms, the
-// Trowbridge-Reitz distribution and the shading frame they are built on.
+// Trowbridge-Reitz distribution and the shading frame they are built on;
+// Lambertian reflection with Lambertian transmission.
 #include "mcrt/materials/bsdf_sample.hpp"
 #include "mcrt/materials/conductor_bsdf.hpp"
 #include "mcrt/materials/dielectric_bsdf.hpp"
 #include "mcrt/materials/diffuse_bsdf.hpp"
+#include "mcrt/materials/diffuse_transmission_bsdf.hpp"
 #include "mcrt/materials/fresnel.hpp"
 #include "mcrt/materials/shading_frame.hpp"
 #include "mcrt/materials/trowbridge_reitz.hpp"

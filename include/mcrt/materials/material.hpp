@@ -8,6 +8,7 @@
 #include "mcrt/core/ray.hpp"
 #include "mcrt/core/rng.hpp"
 #include "mcrt/geometry/hit_record.hpp"
+#include "mcrt/materials/diffuse_transmission_material.hpp"
 #include "mcrt/materials/microfacet_materials.hpp"
 #include "mcrt/materials/texture.hpp"
 #include "mcrt/sampling/warp.hpp"
@@ -49,12 +50,14 @@ struct diffuse_light {
   std::uint32_t surface = no_surface;
 };
 
-// pbrt-v4's conductor and dielectric (microfacet_materials.hpp) come last:
+// pbrt-v4's conductor and dielectric (microfacet_materials.hpp) and
+// diffusetransmission (diffuse_transmission_material.hpp) come last:
 // Shirley's scenes pay nothing for them.
-using material =
-    std::variant<lambertian, metal, dielectric, diffuse_light, textured_diffuse, conductor_material, dielectric_material>;
+using material = std::variant<lambertian, metal, dielectric, diffuse_light, textured_diffuse, conductor_material,
+                              dielectric_material, diffuse_transmission_material>;
 
-// The BSDF of a material that has one (pbrt-v4's conductor and dielectric)
+// The BSDF of a material that has one (pbrt-v4's conductor, dielectric and
+// diffusetransmission)
 // at a hit, passed to f; false for the others (Shirley's materials,
 // diffuse ones and lights).
 // Whether m has a BSDF (with_bsdf calls its f): a test the integrators can
@@ -62,7 +65,8 @@ using material =
 // alternatives as with_bsdf (test_integrators checks that they agree on
 // every alternative of material).
 inline bool has_bsdf(const material& m) {
-  return std::holds_alternative<conductor_material>(m) || std::holds_alternative<dielectric_material>(m);
+  return std::holds_alternative<conductor_material>(m) || std::holds_alternative<dielectric_material>(m) ||
+         std::holds_alternative<diffuse_transmission_material>(m);
 }
 
 template <class F>
@@ -73,6 +77,10 @@ inline bool with_bsdf(const material& m, const hit_record& rec, F&& f) {
   }
   if (const auto* d = std::get_if<dielectric_material>(&m)) {
     f(d->at(rec));
+    return true;
+  }
+  if (const auto* t = std::get_if<diffuse_transmission_material>(&m)) {
+    f(t->at(rec));
     return true;
   }
   return false;
