@@ -23,6 +23,24 @@ microfacet_roughness roughness(params& p, values& v) {
   return r;
 }
 
+// A dielectric's IOR `eta`: a float or a spectrum (default 1.5). One IOR for
+// the three channels: a named glass's at 550 nm, a sampled spectrum's at
+// 532 nm (mcrt renders no dispersion).
+float ior(params& p, values& v) {
+  float eta = 1.5f;
+  if (const param* e = p.find("eta")) {
+    if (e->type == "float") {
+      eta = static_cast<float>(p.real("eta", 1.5));
+    } else if (e->type == "spectrum") {
+      eta = v.spectrum(p, "eta", spectrum_use::unbounded)->g;
+    } else {
+      p.fail(*e, "must be a float or a spectrum (textured IORs are not supported)");
+    }
+    if (!(eta > 0.0f) || !std::isfinite(eta)) p.fail(*e, "must be > 0");
+  }
+  return eta;
+}
+
 }  // namespace
 
 mcrt::material make_material(const std::string& directive_name, const std::string& type, params& p, values& v) {
@@ -56,20 +74,13 @@ mcrt::material make_material(const std::string& directive_name, const std::strin
     m = c;
   } else if (type == "dielectric") {
     dielectric_material g;
-    if (const param* e = p.find("eta")) {
-      if (e->type == "float") {
-        g.eta = static_cast<float>(p.real("eta", 1.5));
-      } else if (e->type == "spectrum") {
-        // One IOR for the three channels: a named glass's at 550 nm, a
-        // sampled spectrum's at 532 nm (mcrt renders no dispersion).
-        g.eta = v.spectrum(p, "eta", spectrum_use::unbounded)->g;
-      } else {
-        p.fail(*e, "must be a float or a spectrum (textured IORs are not supported)");
-      }
-      if (!(g.eta > 0.0f) || !std::isfinite(g.eta)) p.fail(*e, "must be > 0");
-    }
+    g.eta = ior(p, v);
     g.roughness = roughness(p, v);
     m = g;
+  } else if (type == "thindielectric") {
+    // pbrt-v4's ThinDielectricMaterial::Create: eta (float or spectrum,
+    // default 1.5); no roughness (a thin slab is smooth).
+    m = thin_dielectric_material{ior(p, v)};
   } else if (type == "diffusetransmission") {
     // pbrt-v4's DiffuseTransmissionMaterial::Create: reflectance and
     // transmittance 0.25 by default, scale 1; scale times each is clamped
@@ -82,7 +93,7 @@ mcrt::material make_material(const std::string& directive_name, const std::strin
     m = t;
   } else {
     refuse(p.loc(), directive_name + " " + quoted(type) +
-                        ": not supported (supported: diffuse, conductor, dielectric, diffusetransmission)");
+                        ": not supported (supported: diffuse, conductor, dielectric, thindielectric, diffusetransmission)");
   }
   return m;
 }

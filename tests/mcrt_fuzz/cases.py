@@ -544,6 +544,13 @@ def lights() -> list[Case]:
                          "unknown-param": '"float sigma" 1', "t-no-texture": '"texture transmittance" "nope"',
                          "scale-1e39": '"float scale" 1e39'}.items():
         mat(f"diffusetransmission-{name}", f'Material "diffusetransmission" {params}', expect=REFUSED)
+    for e in ("1", "1e30", "1e-30"):
+        mat(f"thindielectric-eta-{e}", f'Material "thindielectric" "float eta" {e}', expect=RENDERED)
+    mat("thindielectric-default", 'Material "thindielectric"', expect=RENDERED)
+    mat("thindielectric-eta-named", 'Material "thindielectric" "spectrum eta" "glass-BAF10"', expect=RENDERED)
+    for e in ("0", "-1"):
+        mat(f"thindielectric-eta-{e}", f'Material "thindielectric" "float eta" {e}', expect=REFUSED)
+    mat("thindielectric-roughness", 'Material "thindielectric" "float roughness" 0.1', expect=REFUSED)
     mat("unknown-material", 'Material "coateddiffuse"', note="an unsupported material")
     mat("named-undefined", 'NamedMaterial "nope"', note="NamedMaterial of nothing")
     mat("makenamed-no-type", 'MakeNamedMaterial "m"\nNamedMaterial "m"', note="MakeNamedMaterial without a type")

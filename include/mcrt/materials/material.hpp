@@ -10,6 +10,7 @@
 #include "mcrt/geometry/hit_record.hpp"
 #include "mcrt/materials/diffuse_transmission_material.hpp"
 #include "mcrt/materials/microfacet_materials.hpp"
+#include "mcrt/materials/thin_dielectric_material.hpp"
 #include "mcrt/materials/texture.hpp"
 #include "mcrt/sampling/warp.hpp"
 
@@ -50,14 +51,15 @@ struct diffuse_light {
   std::uint32_t surface = no_surface;
 };
 
-// pbrt-v4's conductor and dielectric (microfacet_materials.hpp) and
-// diffusetransmission (diffuse_transmission_material.hpp) come last:
-// Shirley's scenes pay nothing for them.
+// pbrt-v4's conductor and dielectric (microfacet_materials.hpp),
+// diffusetransmission (diffuse_transmission_material.hpp) and thindielectric
+// (thin_dielectric_material.hpp) come last: Shirley's scenes pay nothing
+// for them.
 using material = std::variant<lambertian, metal, dielectric, diffuse_light, textured_diffuse, conductor_material,
-                              dielectric_material, diffuse_transmission_material>;
+                              dielectric_material, diffuse_transmission_material, thin_dielectric_material>;
 
-// The BSDF of a material that has one (pbrt-v4's conductor, dielectric and
-// diffusetransmission)
+// The BSDF of a material that has one (pbrt-v4's conductor, dielectric,
+// diffusetransmission and thindielectric)
 // at a hit, passed to f; false for the others (Shirley's materials,
 // diffuse ones and lights).
 // Whether m has a BSDF (with_bsdf calls its f): a test the integrators can
@@ -66,7 +68,7 @@ using material = std::variant<lambertian, metal, dielectric, diffuse_light, text
 // every alternative of material).
 inline bool has_bsdf(const material& m) {
   return std::holds_alternative<conductor_material>(m) || std::holds_alternative<dielectric_material>(m) ||
-         std::holds_alternative<diffuse_transmission_material>(m);
+         std::holds_alternative<diffuse_transmission_material>(m) || std::holds_alternative<thin_dielectric_material>(m);
 }
 
 template <class F>
@@ -80,6 +82,10 @@ inline bool with_bsdf(const material& m, const hit_record& rec, F&& f) {
     return true;
   }
   if (const auto* t = std::get_if<diffuse_transmission_material>(&m)) {
+    f(t->at(rec));
+    return true;
+  }
+  if (const auto* t = std::get_if<thin_dielectric_material>(&m)) {
     f(t->at(rec));
     return true;
   }
