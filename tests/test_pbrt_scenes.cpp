@@ -333,6 +333,31 @@ AttributeEnd
   }
 }
 
+// Shapes under the interface material (and its deprecated name "none") are
+// no surfaces: a sphere around the whole scene, a disk between the light
+// and the floor and a mesh through the floor change nothing, and the floor
+// gets Lambert's irradiance from the nested triangle as without them.
+TEST_P(PbrtFloor, InterfaceShapesLetEveryRayThrough) {
+  const std::string around = R"(
+AttributeBegin
+  Material "interface"
+  Shape "sphere" "float radius" 30
+  Translate 0 0.6 0
+  Rotate 90 1 0 0
+  Shape "disk" "float radius" 3
+AttributeEnd
+AttributeBegin
+  Material "none"
+  Shape "trianglemesh" "point3 P" [ -5 -1 0  5 -1 0  0 2 0 ] "integer indices" [ 0 1 2 ]
+AttributeEnd
+)";
+  const pbrt::built_scene b = from_text(floor_scene(with(nested_triangle, "") + around));
+  EXPECT_EQ(b.world.object_count(), 3u) << "the floor's two triangles and the light's one";
+  const std::vector<glm::dvec3> poly = light_triangles(b.world).at(0);
+  int id = 600;
+  for (const auto& [x, z] : floor_points) check(floor_radiance(b.world, GetParam(), x, z, id++), polygon_floor(poly, x, z), "interface");
+}
+
 INSTANTIATE_TEST_SUITE_P(All, PbrtFloor, ::testing::Values(integrator_kind::mixture, integrator_kind::nee, integrator_kind::mis),
                          integrator_name);
 
@@ -932,6 +957,9 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         refusal{"WorldBegin\nShape \"curve\"\n", 2, "Shape \"curve\": not supported (supported: trianglemesh"},
         refusal{"WorldBegin\nMaterial \"coateddiffuse\"\n", 2, "not supported"},
+        refusal{"WorldBegin\nMaterial \"interface\"\nAreaLightSource \"diffuse\"\nShape \"sphere\"\n", 3,
+                "interface material"},
+        refusal{"WorldBegin\nMaterial \"interface\" \"float eta\" 1.5\n", 2, "not supported"},
         refusal{"WorldBegin\nLightSource \"infinite\"\n", 2, "LightSource \"infinite\": not supported"},
         refusal{"Camera \"orthographic\"\nWorldBegin\n", 1, "Camera \"orthographic\": not supported"},
         refusal{"Integrator \"bdpt\"\nWorldBegin\n", 1, "Integrator \"bdpt\": not supported"},

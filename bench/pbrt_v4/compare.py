@@ -68,7 +68,7 @@ def run(args):
     if standins and scene_copy.sampler_kind(args.file) == '"pmj02bn"':
         raise scene_copy.SceneError(f"{args.file}: Sampler \"pmj02bn\" reads pbrt-v4's table, a stand-in in this build")
     copy = scene_copy.settings_copy(args.file, args.width, args.height, args.spp, args.max_depth,
-                                    grey_lights=args.grey_lights)
+                                    integrator=args.integrator, grey_lights=args.grey_lights)
     runs = {n: [] for n in binaries}
     try:
         refs = {n: _reference(n, b, copy, args, out_dir) for n, b in binaries.items()}
@@ -82,7 +82,7 @@ def run(args):
         copy.unlink()
 
     res = {"file": str(args.file), "grey_lights": args.grey_lights, "width": args.width, "height": args.height, "spp": args.spp,
-           "ref_spp": args.ref_spp, "max_depth": args.max_depth, "seeds": args.seeds,
+           "ref_spp": args.ref_spp, "max_depth": args.max_depth, "integrator": args.integrator, "seeds": args.seeds,
            "threads": args.threads, "renderers": {}}
     for n in binaries:
         ref, noise = refs[n]
@@ -129,7 +129,7 @@ def report(res):
     m, p = res["renderers"]["mcrt"], res["renderers"]["pbrt-v4"]
     grey = " (lights made grey)" if res["grey_lights"] else ""
     lines = [f"{res['file']}{grey}: {res['width']}x{res['height']}, {res['spp']} spp (references {res['ref_spp']}), "
-             f"maxdepth {res['max_depth']}, {res['seeds']} seeds, {res['threads']} threads each",
+             f"{res.get('integrator', 'path')} maxdepth {res['max_depth']}, {res['seeds']} seeds, {res['threads']} threads each",
              "", "| | mcrt | pbrt-v4 | difference |", "|---|---|---|---|"]
     for c, name in enumerate("RGB"):
         lines.append(f"| mean {name} | {m['channel_means'][c]:.5g} | {p['channel_means'][c]:.5g} | "

@@ -9,8 +9,8 @@ fixes:
   `filename` dropped (each renderer is given its output) and `savefp16`
   false (pbrt-v4 writes half floats by default);
 - `Sampler`: kept with `pixelsamples` set (both renderers also take --spp);
-- `Integrator`: `"path"` with `maxdepth` set, whatever the file asked for
-  (its other parameters dropped; `regularize` is not kept).
+- `Integrator`: `"path"` (or `"volpath"`) with `maxdepth` set, whatever the
+  file asked for (its other parameters dropped; `regularize` is not kept).
 
 Every line keeps its number, so that a renderer's message about the copy
 names the original's line.

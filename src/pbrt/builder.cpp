@@ -24,6 +24,12 @@ constexpr int max_samples_per_pixel = 1 << 20;
 constexpr int max_path_depth = 100000;
 
 
+// The current material when it is "interface": no surface. Shapes made
+// under it are read and checked, and not added (rays pass them, as
+// pbrt-v4's volpath lets every ray through them; its path stops light
+// samples' shadow rays there); an area light on them is refused.
+constexpr std::uint32_t interface_material = 0xfffffffeu;
+
 // What pbrt-v4's graphics state holds that mcrt uses.
 struct graphics_state {
   transform ctm;
@@ -414,9 +420,10 @@ class builder {
     if (d.name == "MakeNamedMaterial") p.string("type");
     if (p.find("displacement")) p.fail(*p.find("displacement"), "is not supported");
     if (p.find("normalmap")) p.fail(*p.find("normalmap"), "is not supported");
-    const mcrt::material m = make_material(d.name, type, p, values_);
+    const std::optional<mcrt::material> m = make_material(d.name, type, p, values_);
     p.finish();
-    out_.world.materials.push_back(m);
+    if (!m) return interface_material;
+    out_.world.materials.push_back(*m);
     return static_cast<std::uint32_t>(out_.world.materials.size() - 1);
   }
 
@@ -451,6 +458,14 @@ class builder {
   // that reflects with it.
   std::uint32_t shape_material(bool& emits) {
     emits = state_.light && state_.light->L != color(0.0f);
+    if (state_.material == interface_material) {
+      // pbrt-v4 drops the light with a warning (scene.cpp): mcrt ignores
+      // nothing silently.
+      if (state_.light)
+        refuse(state_.light->loc, "AreaLightSource on a shape with the interface material (no surface; pbrt-v4 drops "
+                                  "the light with a warning)");
+      emits = false;
+    }
     if (!emits) return state_.material;
     diffuse_light dl;
     dl.emit = state_.light->L;
@@ -575,6 +590,7 @@ class builder {
     auto mesh = std::make_shared<const triangle_mesh>(std::move(m));
     bool emits = false;
     const std::uint32_t mat = shape_material(emits);
+    if (mat == interface_material) return;  // no surface: rays pass
     const light_sampling st = emits ? strategy_for(light_sampling::area) : light_sampling::area;
     for (const triangle& tri : triangles_of(mesh)) {
       if (tri.area() == 0.0f) continue;  // a degenerate triangle is never hit
@@ -711,6 +727,7 @@ class builder {
     sp.flip = state_.reverse_orientation != state_.ctm.swaps_handedness();
     bool emits = false;
     const std::uint32_t mat = shape_material(emits);
+    if (mat == interface_material) return;  // no surface: rays pass
     if (!emits) {
       out_.world.add(sp, mat);
       return;
@@ -760,6 +777,7 @@ class builder {
     const ellipse e = ellipse::make(vec3(c), vec3(a1), vec3(a2), flip);
     bool emits = false;
     const std::uint32_t mat = shape_material(emits);
+    if (mat == interface_material) return;  // no surface: rays pass
     out_.world.add(e, mat);
     if (!emits) return;
     const light_sampling st = strategy_for(light_sampling::area);

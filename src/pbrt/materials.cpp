@@ -43,7 +43,11 @@ float ior(params& p, values& v) {
 
 }  // namespace
 
-mcrt::material make_material(const std::string& directive_name, const std::string& type, params& p, values& v) {
+std::optional<mcrt::material> make_material(const std::string& directive_name, const std::string& type, params& p,
+                                            values& v) {
+  // pbrt-v4's MaterialHandle::Create: "interface" (and the deprecated "none")
+  // is no material at all.
+  if (type == "interface" || type == "none") return std::nullopt;
   mcrt::material m;
   if (type == "diffuse") {
     const std::shared_ptr<const texture> r = v.spectrum_texture(p, "reflectance", color(0.5f));
@@ -93,7 +97,7 @@ mcrt::material make_material(const std::string& directive_name, const std::strin
     m = t;
   } else {
     refuse(p.loc(), directive_name + " " + quoted(type) +
-                        ": not supported (supported: diffuse, conductor, dielectric, thindielectric, diffusetransmission)");
+                        ": not supported (supported: diffuse, conductor, dielectric, thindielectric, diffusetransmission, interface)");
   }
   return m;
 }

@@ -551,6 +551,12 @@ def lights() -> list[Case]:
     for e in ("0", "-1"):
         mat(f"thindielectric-eta-{e}", f'Material "thindielectric" "float eta" {e}', expect=REFUSED)
     mat("thindielectric-roughness", 'Material "thindielectric" "float roughness" 0.1', expect=REFUSED)
+    mat("interface-floor", 'Material "interface"', expect=RENDERED, note="the floor no surface")
+    mat("none-floor", 'Material "none"', expect=RENDERED, note="the deprecated name of interface")
+    mat("interface-param", 'Material "interface" "float eta" 1.33', expect=REFUSED)
+    cases.append(pb(f + "interface-light", A.pbrt_scene(
+        light='AttributeBegin\nMaterial "interface"\nAreaLightSource "diffuse" "rgb L" [ 1 1 1 ]\n' + A.LIGHT_MESH +
+              'AttributeEnd\n'), expect=REFUSED, note="an area light on an interface shape"))
     mat("unknown-material", 'Material "coateddiffuse"', note="an unsupported material")
     mat("named-undefined", 'NamedMaterial "nope"', note="NamedMaterial of nothing")
     mat("makenamed-no-type", 'MakeNamedMaterial "m"\nNamedMaterial "m"', note="MakeNamedMaterial without a type")

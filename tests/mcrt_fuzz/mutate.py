@@ -57,7 +57,7 @@ SNIPPETS = [
     "Accelerator \"bvh\"", "MediumInterface \"\" \"\"", "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"",
     "Material \"diffuse\" \"rgb reflectance\" [ 0.2 0.4 0.6 ]", "Material \"conductor\" \"float roughness\" 0.1",
     "Material \"dielectric\" \"float eta\" 1.33", "Material \"coateddiffuse\"",
-    "Material \"diffusetransmission\" \"rgb transmittance\" [ 0.5 0.5 0.5 ]", "Material \"thindielectric\"",
+    "Material \"diffusetransmission\" \"rgb transmittance\" [ 0.5 0.5 0.5 ]", "Material \"thindielectric\"", "Material \"interface\"",
     "MakeNamedMaterial \"m\" \"string type\" \"diffuse\"", "NamedMaterial \"m\"",
     "Texture \"tx\" \"spectrum\" \"checkerboard\" \"float uscale\" 4",
     "Texture \"tf\" \"float\" \"constant\" \"float value\" 0.5",
