@@ -16,17 +16,7 @@ done
 
 packages=(cmake g++ make ninja-build pkg-config libglm-dev libopenimageio-dev nlohmann-json3-dev libcli11-dev
           libgtest-dev libbenchmark-dev libboost-math-dev zlib1g-dev python3 python3-venv)
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  echo "setup: installing ${missing[*]}" >&2
-  sudo=""
-  [ "$(id -u)" -ne 0 ] && sudo="sudo"
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
+bash scripts/install_debian.sh "${packages[@]}"
 
 # Python for scripts/ (the error-vs-time study, its plots and its Dask backend)
 # and for the documentation check (cffconvert validates CITATION.cff).

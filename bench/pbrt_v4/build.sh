@@ -31,17 +31,7 @@ done
 
 packages=(cmake ninja-build g++ zlib1g-dev libopenexr-dev libgl-dev libx11-dev libxrandr-dev libxinerama-dev
           libxcursor-dev libxi-dev libxkbcommon-dev)
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  echo "pbrt-v4: installing ${missing[*]}" >&2
-  sudo=""
-  [ "$(id -u)" -ne 0 ] && sudo="sudo"
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
+bash scripts/install_debian.sh "${packages[@]}"
 
 mkdir -p "$out"
 if [ ! -f "$src/CMakeLists.txt" ]; then

@@ -52,7 +52,7 @@ def _references(top):
         seen.add(f)
         text = f.read_text(errors="replace")
         # The Film's filename is an output, not a file the scene reads.
-        text = "".join(s_text for s_text in _without_film(text))
+        text = "".join(_without_film(text))
         for name in _REF.findall(text):
             path = base / name
             out.append((name, path))

@@ -58,38 +58,33 @@ struct diffuse_light {
 using material = std::variant<lambertian, metal, dielectric, diffuse_light, textured_diffuse, conductor_material,
                               dielectric_material, diffuse_transmission_material, thin_dielectric_material>;
 
-// The BSDF of a material that has one (pbrt-v4's conductor, dielectric,
-// diffusetransmission and thindielectric)
-// at a hit, passed to f; false for the others (Shirley's materials,
-// diffuse ones and lights).
+// The materials that make a BSDF at a hit (each has at(rec)): pbrt-v4's
+// conductor, dielectric, diffusetransmission and thindielectric. has_bsdf
+// and with_bsdf both read this one list.
+template <class... Ms>
+struct material_list {};
+using bsdf_materials =
+    material_list<conductor_material, dielectric_material, diffuse_transmission_material, thin_dielectric_material>;
+
 // Whether m has a BSDF (with_bsdf calls its f): a test the integrators can
-// make before leaving their inlined loop for with_bsdf. It names the same
-// alternatives as with_bsdf (test_integrators checks that they agree on
-// every alternative of material).
+// make before leaving their inlined loop for with_bsdf.
 inline bool has_bsdf(const material& m) {
-  return std::holds_alternative<conductor_material>(m) || std::holds_alternative<dielectric_material>(m) ||
-         std::holds_alternative<diffuse_transmission_material>(m) || std::holds_alternative<thin_dielectric_material>(m);
+  return []<class... Ms>(const material& mm, material_list<Ms...>) {
+    return (std::holds_alternative<Ms>(mm) || ...);
+  }(m, bsdf_materials{});
 }
 
+// The BSDF of m at a hit, passed to f, where m has one; false for the
+// others (Shirley's materials, diffuse ones and lights).
 template <class F>
 inline bool with_bsdf(const material& m, const hit_record& rec, F&& f) {
-  if (const auto* c = std::get_if<conductor_material>(&m)) {
-    f(c->at(rec));
-    return true;
-  }
-  if (const auto* d = std::get_if<dielectric_material>(&m)) {
-    f(d->at(rec));
-    return true;
-  }
-  if (const auto* t = std::get_if<diffuse_transmission_material>(&m)) {
-    f(t->at(rec));
-    return true;
-  }
-  if (const auto* t = std::get_if<thin_dielectric_material>(&m)) {
-    f(t->at(rec));
-    return true;
-  }
-  return false;
+  return [&]<class... Ms>(material_list<Ms...>) {
+    return ([&] {
+      const auto* x = std::get_if<Ms>(&m);
+      if (x) f(x->at(rec));
+      return x != nullptr;
+    }() || ...);
+  }(bsdf_materials{});
 }
 
 // The albedo of a diffuse material at a hit (lambertian or textured);
