@@ -1,11 +1,10 @@
 """python3 -m bench.pbrt_v4 FILE.pbrt [options] | corpus DIR [options]: see README.md.
 
 Re-runs itself with the repository's .venv (scripts/setup.sh --python makes
-it) and installs the OpenEXR Python package there on first use; builds
+it: numpy; EXR files are read by scripts/mcrt_study/exr.py); builds
 pbrt-v4 with build.sh when --pbrt is not given and it is not built.
 """
 import argparse
-import importlib.util
 import os
 import subprocess
 import sys
@@ -20,9 +19,6 @@ def bootstrap():
         if not venv.exists():
             subprocess.run(["bash", str(ROOT / "scripts" / "setup.sh"), "--python"], check=True)
         os.execv(str(venv), [str(venv), "-m", "bench.pbrt_v4", *sys.argv[1:]])
-    if importlib.util.find_spec("OpenEXR") is None:
-        subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--disable-pip-version-check", "OpenEXR"],
-                       check=True)
 
 
 def parse_corpus(argv):

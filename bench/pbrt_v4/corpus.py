@@ -79,6 +79,23 @@ def _png(path):
                      + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
 
 
+def _exr(path):
+    """1x1 pixel of 0.5 grey: a single-part scanline OpenEXR file, float RGB,
+    no compression (openexr.com, "OpenEXR File Layout")."""
+    attr = lambda name, kind, value: name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(value)) + value
+    channels = b"".join(c + b"\0" + struct.pack("<iB3xii", 2, 0, 1, 1) for c in (b"B", b"G", b"R")) + b"\0"
+    box = struct.pack("<4i", 0, 0, 0, 0)
+    header = (struct.pack("<ii", 20000630, 2) + attr("channels", "chlist", channels)
+              + attr("compression", "compression", b"\0") + attr("dataWindow", "box2i", box)
+              + attr("displayWindow", "box2i", box) + attr("lineOrder", "lineOrder", b"\0")
+              + attr("pixelAspectRatio", "float", struct.pack("<f", 1.0))
+              + attr("screenWindowCenter", "v2f", struct.pack("<2f", 0.0, 0.0))
+              + attr("screenWindowWidth", "float", struct.pack("<f", 1.0)) + b"\0")
+    pixels = struct.pack("<3f", 0.5, 0.5, 0.5)
+    offset = len(header) + 8
+    path.write_bytes(header + struct.pack("<Q", offset) + struct.pack("<ii", 0, len(pixels)) + pixels)
+
+
 def _stand_in(path):
     path.parent.mkdir(parents=True, exist_ok=True)
     ext = path.suffix.lower()
@@ -93,10 +110,7 @@ def _stand_in(path):
     elif ext == ".pfm":
         path.write_bytes(b"PF\n1 1\n-1.0\n" + struct.pack("<3f", 0.5, 0.5, 0.5))
     elif ext == ".exr":
-        import numpy as np
-        import OpenEXR
-        OpenEXR.File({"compression": OpenEXR.NO_COMPRESSION, "type": OpenEXR.scanlineimage},
-                     {"RGB": np.full((1, 1, 3), 0.5, dtype=np.float32)}).write(str(path))
+        _exr(path)
     elif ext == ".pbrt":
         path.write_text("# stand-in: absent from the copy\n")
     else:

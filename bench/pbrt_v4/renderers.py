@@ -5,11 +5,14 @@ acceleration structures and writing the image included), the same for
 both: neither renderer's own timer covers the same span as the other's.
 """
 import os
+import sys
 import subprocess
 import time
 from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 
 
 class RenderError(Exception):
@@ -17,11 +20,11 @@ class RenderError(Exception):
 
 
 def read_exr(path):
-    """The RGB channels of an EXR as float64, (height, width, 3)."""
-    import OpenEXR
-    with OpenEXR.File(str(path), separate_channels=True) as f:
-        ch = f.channels()
-        return np.stack([np.asarray(ch[c].pixels, dtype=np.float64) for c in ("R", "G", "B")], axis=-1)
+    """The RGB channels of an EXR as float64, (height, width, 3), by the
+    study package's reader (scripts/mcrt_study/exr.py: numpy and zlib; it
+    reads both renderers' files)."""
+    from mcrt_study.exr import read_rgb
+    return np.asarray(read_rgb(path), dtype=np.float64)
 
 
 def _run(cmd, out):
