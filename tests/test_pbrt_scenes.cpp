@@ -691,6 +691,34 @@ AttributeEnd
   }
 }
 
+// LookAt's camera-from-world is the inverse of an affine matrix: it must
+// come out affine with its last row exactly 0 0 0 1, or the camera's check
+// refuses it ("not affine"), as it once did for LookAt 0 1.6 -5  0 0.7 0
+// 0 1 0, whose general 4x4 inverse leaves ~1e-17 there.
+TEST(PbrtLookAt, EveryViewIsAcceptedWithAnExactAffineMatrix) {
+  pcg32 rng(7, 11);
+  const auto coord = [&] { return 20.0f * rng.uniform() - 10.0f; };
+  std::vector<std::string> views = {"0 1.6 -5  0 0.7 0  0 1 0"};
+  for (int i = 0; i < 300; ++i) {
+    std::string v;
+    for (int k = 0; k < 6; ++k) v += std::to_string(coord()) + " ";
+    views.push_back(v + "0 1 0");
+  }
+  for (const std::string& view : views) {
+    const pbrt::built_scene b = from_text("LookAt " + view + "\nCamera \"perspective\"\nWorldBegin\n" +
+                                          "Shape \"sphere\"\n");
+    const glm::dmat4& m = b.camera_from_world.m;
+    EXPECT_EQ(m[0][3], 0.0) << view;
+    EXPECT_EQ(m[1][3], 0.0) << view;
+    EXPECT_EQ(m[2][3], 0.0) << view;
+    EXPECT_EQ(m[3][3], 1.0) << view;
+    // And it is the inverse: the eye maps to the camera's origin.
+    const glm::dmat4 id = m * b.camera_from_world.inv;
+    for (int j = 0; j < 4; ++j)
+      for (int k = 0; k < 4; ++k) EXPECT_NEAR(id[j][k], j == k ? 1.0 : 0.0, 1e-12) << view;
+  }
+}
+
 // A light's emitting material reflects with the shape's own material: a
 // white diffuse emitter lit by another light sends back more than its
 // emission (a black one, nothing more).

@@ -40,6 +40,24 @@ std::optional<transform> transform::rotate(double degrees, const glm::dvec3& axi
   return t;
 }
 
+namespace {
+
+// The inverse of m. Of an affine m (last row 0 0 0 1) it is affine with
+// that row exact: GLM's general 4x4 inverse leaves rounding noise of ~1e-17
+// there, and the camera's check (camera.hpp) refuses a last row that is
+// not exactly 0 0 0 1 (pbrt-v4's cameras are affine).
+glm::dmat4 inverse_of(const glm::dmat4& m) {
+  if (m[0][3] == 0.0 && m[1][3] == 0.0 && m[2][3] == 0.0 && m[3][3] == 1.0) {
+    const glm::dmat3 a_inv = glm::inverse(glm::dmat3(m));
+    glm::dmat4 r(a_inv);  // last row and column 0 0 0 1
+    r[3] = glm::dvec4(-(a_inv * glm::dvec3(m[3])), 1.0);
+    return r;
+  }
+  return glm::inverse(m);
+}
+
+}  // namespace
+
 std::optional<transform> transform::look_at(const glm::dvec3& eye, const glm::dvec3& look, const glm::dvec3& up) {
   const glm::dvec3 view = look - eye;
   if (!(glm::length(view) > 0.0) || !(glm::length(up) > 0.0)) return std::nullopt;
@@ -52,7 +70,7 @@ std::optional<transform> transform::look_at(const glm::dvec3& eye, const glm::dv
   world_from_camera.m[1] = glm::dvec4(new_up, 0.0);
   world_from_camera.m[2] = glm::dvec4(dir, 0.0);
   world_from_camera.m[3] = glm::dvec4(eye, 1.0);
-  world_from_camera.inv = glm::inverse(world_from_camera.m);
+  world_from_camera.inv = inverse_of(world_from_camera.m);
   return world_from_camera.inverse();
 }
 
@@ -63,7 +81,7 @@ std::optional<transform> transform::from_pbrt_matrix(const std::array<double, 16
   for (int j = 0; j < 4; ++j) t.m[j] = glm::dvec4(v[4 * j], v[4 * j + 1], v[4 * j + 2], v[4 * j + 3]);
   const double det = glm::determinant(t.m);
   if (!(std::abs(det) > 0.0) || !std::isfinite(det)) return std::nullopt;
-  t.inv = glm::inverse(t.m);
+  t.inv = inverse_of(t.m);
   return t;
 }
 
