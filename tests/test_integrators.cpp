@@ -146,8 +146,8 @@ TEST(LightSelection, ChoosesWithTheStatedProbabilities) {
 
 // has_bsdf, the integrators' test before their out-of-line BSDF vertex,
 // says yes for exactly the materials with_bsdf hands a BSDF: every
-// alternative of material, default-constructed (a conductor given its
-// complex IOR, which has no default).
+// alternative of material, default-constructed (a conductor, bare or
+// coated, given its complex IOR, which has no default).
 TEST(Materials, HasBsdfIsWhatWithBsdfTakes) {
   const hit_record rec;
   const auto one = std::make_shared<const texture>(texture::constant(color(1.0f)));
@@ -156,6 +156,7 @@ TEST(Materials, HasBsdfIsWhatWithBsdfTakes) {
         [&] {
           material m{std::in_place_index<I>};
           if (auto* c = std::get_if<conductor_material>(&m)) c->eta = c->k = one;
+          if (auto* c = std::get_if<coated_conductor_material>(&m)) c->conductor.eta = c->conductor.k = one;
           bool called = false;
           const bool taken = with_bsdf(m, rec, [&](const auto&) { called = true; });
           EXPECT_EQ(taken, called) << "alternative " << I;

@@ -557,7 +557,43 @@ def lights() -> list[Case]:
     cases.append(pb(f + "interface-light", A.pbrt_scene(
         light='AttributeBegin\nMaterial "interface"\nAreaLightSource "diffuse" "rgb L" [ 1 1 1 ]\n' + A.LIGHT_MESH +
               'AttributeEnd\n'), expect=REFUSED, note="an area light on an interface shape"))
-    mat("unknown-material", 'Material "coateddiffuse"', note="an unsupported material")
+    # coateddiffuse and coatedconductor: defaults, every parameter at its
+    # extremes (a slab of 0 and 1e30, g at +-1 and beyond, a white medium,
+    # walks of 0 and 1000 events, 1000 walks), textured parameters; and what
+    # must be refused.
+    pre_tex = ('Texture "checks" "spectrum" "checkerboard" "float uscale" 1e30 "rgb tex1" [ 1 1 1 ] '
+               '"rgb tex2" [ 0 0 0 ]\nTexture "fchecks" "float" "checkerboard" "float tex1" 0 "float tex2" 1e30\n')
+    for name, params in {"default": "", "thickness-0": '"float thickness" 0', "thickness-1e30": '"float thickness" 1e30',
+                         "thickness-1e-45": '"float thickness" 1e-45',
+                         "slab-white": '"rgb albedo" [ 1 1 1 ] "float thickness" 5 "float g" 0.9',
+                         "g-1": '"rgb albedo" [ 0.5 0.5 0.5 ] "float g" 1', "g-neg-5": '"rgb albedo" [ 0.5 0.5 0.5 ] "float g" -5',
+                         "maxdepth-0": '"integer maxdepth" 0', "maxdepth-1000": '"integer maxdepth" 1000 "rgb albedo" [ 1 1 1 ]',
+                         "nsamples-16": '"integer nsamples" 16', "eta-1": '"float eta" 1', "eta-1e30": '"float eta" 1e30',
+                         "eta-1e-30": '"float eta" 1e-30', "eta-named": '"spectrum eta" "glass-BK7"',
+                         "rough-extreme": '"float uroughness" 1e-30 "float vroughness" 1e30',
+                         "reflectance-2": '"rgb reflectance" [ 2 2 2 ]', "albedo-2": '"rgb albedo" [ 2 2 2 ]',
+                         "textured": '"texture reflectance" "checks" "texture albedo" "checks" "texture thickness" "fchecks" '
+                                     '"texture g" "fchecks" "texture roughness" "fchecks"'}.items():
+        mat(f"coateddiffuse-{name}", (pre_tex if "textured" in name else "") + f'Material "coateddiffuse" {params}',
+            expect=RENDERED)
+    for name, params in {"default": "", "smooth-smooth": '"float interface.roughness" 0 "float conductor.roughness" 0',
+                         "rough-rough": '"float interface.roughness" 0.3 "float conductor.roughness" 0.5 "rgb albedo" [ 0.5 0.5 0.5 ]',
+                         "reflectance": '"rgb reflectance" [ 0.9 0.6 0.3 ]', "reflectance-1": '"rgb reflectance" [ 1 1 1 ]',
+                         "gold": '"spectrum conductor.eta" "metal-Au-eta" "spectrum conductor.k" "metal-Au-k"',
+                         "ieta-1e30": '"float interface.eta" 1e30', "ieta-1": '"float interface.eta" 1',
+                         "k-0": '"rgb conductor.eta" [ 1.5 1.5 1.5 ] "rgb conductor.k" [ 0 0 0 ]'}.items():
+        mat(f"coatedconductor-{name}", f'Material "coatedconductor" {params}', expect=RENDERED)
+    for name, params in {"nsamples-0": '"integer nsamples" 0', "nsamples-1001": '"integer nsamples" 1001',
+                         "maxdepth-neg": '"integer maxdepth" -1', "maxdepth-float": '"float maxdepth" 3',
+                         "thickness-neg": '"float thickness" -1', "eta-0": '"float eta" 0', "eta-texture": '"texture eta" "checks"',
+                         "albedo-neg": '"rgb albedo" [ -1 0 0 ]', "roughness-neg": '"float roughness" -0.1',
+                         "unknown-param": '"float sigma" 1', "conductor-param": '"float conductor.roughness" 0.1'}.items():
+        mat(f"coateddiffuse-{name}", f'Material "coateddiffuse" {params}', expect=REFUSED)
+    for name, params in {"both-ior": '"rgb reflectance" [ 0.5 0.5 0.5 ] "rgb conductor.eta" [ 1 1 1 ]',
+                         "k-neg": '"rgb conductor.k" [ -1 -1 -1 ]', "ieta-neg": '"float interface.eta" -1',
+                         "bare-roughness": '"float roughness" 0.1', "bare-eta": '"float eta" 1.5'}.items():
+        mat(f"coatedconductor-{name}", f'Material "coatedconductor" {params}', expect=REFUSED)
+    mat("unknown-material", 'Material "subsurface"', note="an unsupported material")
     mat("named-undefined", 'NamedMaterial "nope"', note="NamedMaterial of nothing")
     mat("makenamed-no-type", 'MakeNamedMaterial "m"\nNamedMaterial "m"', note="MakeNamedMaterial without a type")
     # An emitter whose own material reflects hugely, under a huge light.

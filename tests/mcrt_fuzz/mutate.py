@@ -57,6 +57,8 @@ SNIPPETS = [
     "Accelerator \"bvh\"", "MediumInterface \"\" \"\"", "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"",
     "Material \"diffuse\" \"rgb reflectance\" [ 0.2 0.4 0.6 ]", "Material \"conductor\" \"float roughness\" 0.1",
     "Material \"dielectric\" \"float eta\" 1.33", "Material \"coateddiffuse\"",
+    "Material \"coateddiffuse\" \"rgb albedo\" [ 0.5 0.5 0.5 ] \"float g\" 0.5 \"float thickness\" 0.2",
+    "Material \"coatedconductor\" \"float interface.roughness\" 0.1 \"float conductor.roughness\" 0.3",
     "Material \"diffusetransmission\" \"rgb transmittance\" [ 0.5 0.5 0.5 ]", "Material \"thindielectric\"", "Material \"interface\"",
     "MakeNamedMaterial \"m\" \"string type\" \"diffuse\"", "NamedMaterial \"m\"",
     "Texture \"tx\" \"spectrum\" \"checkerboard\" \"float uscale\" 4",
@@ -82,7 +84,8 @@ SNIPPETS = [
 # Names a string token may become.
 NAMES = [
     "trianglemesh", "plymesh", "bilinearmesh", "sphere", "disk", "cylinder", "curve", "loopsubdiv",
-    "diffuse", "conductor", "dielectric", "diffusetransmission", "coateddiffuse", "mix", "interface", "thindielectric",
+    "diffuse", "conductor", "dielectric", "diffusetransmission", "coateddiffuse", "coatedconductor", "mix", "interface",
+    "thindielectric", "subsurface", "measured", "hair",
     "imagemap", "constant", "scale", "checkerboard", "ptex", "spectrum", "float",
     "perspective", "orthographic", "realistic", "rgb", "gbuffer", "spectral",
     "independent", "stratified", "sobol", "zsobol", "halton", "pmj02bn", "path", "volpath", "bdpt", "sppm",
@@ -91,7 +94,8 @@ NAMES = [
     "blackbody L", "spectrum eta", "spectrum k", "texture reflectance", "rgb transmittance",
     "texture roughness", "string filename",
     "bool twosided", "float scale", "integer xresolution", "integer pixelsamples", "integer maxdepth",
-    "float roughness", "float eta", "string encoding", "string wrap", "float uscale", "vector3 S",
+    "float roughness", "float eta", "float thickness", "rgb albedo", "float g", "integer nsamples",
+    "float interface.roughness", "float conductor.roughness", "spectrum conductor.eta", "string encoding", "string wrap", "float uscale", "vector3 S",
     "metal-Au-eta", "metal-Cu-k", "glass-BK7", "stdillum-D65", "srgb", "linear", "gamma 2.2",
     "floor.ply", "icosphere.ply", "torus.ply.gz", "checker.png", "unit_cube.pbrt", "missing.ply", "",
     "floor", "wall", "glass", "gold", "copper", "checks", "stripes", "bumpy",

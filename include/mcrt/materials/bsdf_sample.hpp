@@ -35,6 +35,27 @@ namespace mcrt {
 // a denser medium (sec. 9.5.2), importance is not.
 enum class transport_mode { radiance, importance };
 
+// The other mode: the one light travelling the opposite way carries
+// (pbrt-v4's !mode). A layered BSDF samples the exit side of its walk from
+// wi, against the flow of light.
+inline transport_mode adjoint(transport_mode m) {
+  return m == transport_mode::radiance ? transport_mode::importance : transport_mode::radiance;
+}
+
+// The lobes a sample may choose and a pdf counts (pbrt-v4's
+// BxDFReflTransFlags): all, or only those leaving on wo's side
+// (reflection), or only those crossing the surface (transmission). The
+// interfaces of a layered BSDF (layered_bsdf.hpp) are asked for one kind.
+// A restricted pdf is the density of the restricted sample(): the chosen
+// lobe's probability is renormalised over the allowed lobes.
+enum class bsdf_lobes { all, reflection, transmission };
+
+// Whether a BSDF type scatters only to wo's side of the surface (a
+// renderer then looks for light on that side only): specialised true
+// beside each reflection-only BSDF.
+template <class Bsdf>
+inline constexpr bool reflects_only = false;
+
 struct bsdf_sample {
   vec3 wi{0.0f};        // sampled incident direction, local frame, unit
   color f{0.0f};        // BSDF value for (wo, wi), without the cosine
@@ -42,6 +63,11 @@ struct bsdf_sample {
   bool delta = false;   // a specular lobe: pdf is a discrete probability
   bool transmission = false;  // wi on the other side of the surface than wo
   float eta = 1;        // relative IOR along the ray for transmission (pbrt-v4's etap), else 1
+  // pbrt-v4's pdfIsProportional: f and pdf are those of one random path
+  // (layered_bsdf.hpp), so f / pdf is an unbiased weight, but pdf is not
+  // the density of wi; a multiple-importance weight takes the BSDF's
+  // pdf(wo, wi) instead.
+  bool pdf_is_proportional = false;
 };
 
 }  // namespace mcrt

@@ -43,9 +43,11 @@ struct conductor_bsdf {
   }
 
   // Density of wi per unit SOLID ANGLE: D_wo(wm) / (4 |wo . wm|) with the
-  // half vector faced to +z; 0 for the delta (smooth) lobe.
-  float pdf(const vec3& wo, const vec3& wi, transport_mode = transport_mode::radiance) const {
-    if (!same_hemisphere(wo, wi)) return 0.0f;
+  // half vector faced to +z; 0 for the delta (smooth) lobe, and when only
+  // transmission is asked for (there is none).
+  float pdf(const vec3& wo, const vec3& wi, transport_mode = transport_mode::radiance,
+            bsdf_lobes lobes = bsdf_lobes::all) const {
+    if (!same_hemisphere(wo, wi) || lobes == bsdf_lobes::transmission) return 0.0f;
     if (distrib.effectively_smooth()) return 0.0f;
     vec3 wm = wo + wi;
     if (glm::dot(wm, wm) == 0.0f) return 0.0f;
@@ -54,9 +56,10 @@ struct conductor_bsdf {
     return distrib.pdf(wo, wm) / (4.0f * std::abs(glm::dot(wo, wm)));
   }
 
-  bool sample(const vec3& wo, float /*uc*/, vec2 u, bsdf_sample& out,
-              transport_mode = transport_mode::radiance) const {
+  bool sample(const vec3& wo, float /*uc*/, vec2 u, bsdf_sample& out, transport_mode = transport_mode::radiance,
+              bsdf_lobes lobes = bsdf_lobes::all) const {
     out = bsdf_sample{};
+    if (lobes == bsdf_lobes::transmission) return false;  // a conductor transmits nothing
     // Guard: in the tangent plane the mirror's f = F / |cos| and the rough
     // lobe's 1 / (4 cos_i cos_o) are infinite (pbrt-v4 rejects the rough
     // case only).
@@ -83,5 +86,8 @@ struct conductor_bsdf {
     return true;
   }
 };
+
+template <>
+inline constexpr bool reflects_only<conductor_bsdf> = true;
 
 }  // namespace mcrt

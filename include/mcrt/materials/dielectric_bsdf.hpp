@@ -71,34 +71,44 @@ struct dielectric_bsdf {
 
   // Density of wi per unit SOLID ANGLE over the whole sphere (reflection on
   // wo's side, transmission on the other); 0 for the delta lobes. Does not
-  // depend on the mode.
-  float pdf(const vec3& wo, const vec3& wi, transport_mode = transport_mode::radiance) const {
+  // depend on the mode. With lobes restricted, the density of the
+  // restricted sample(): the allowed lobe's probability is 1.
+  float pdf(const vec3& wo, const vec3& wi, transport_mode = transport_mode::radiance,
+            bsdf_lobes lobes = bsdf_lobes::all) const {
     if (is_delta()) return 0.0f;
     half_vector h;
     if (!generalized_half_vector(wo, wi, h)) return 0.0f;
     const float R = fresnel_dielectric(glm::dot(wo, h.wm), eta), T = 1.0f - R;
-    // Guard: R + T = 1 always; kept as pbrt-v4's check for no lobe to sample.
-    if (R == 0.0f && T == 0.0f) return 0.0f;
-    if (h.reflect) return distrib.pdf(wo, h.wm) / (4.0f * std::abs(glm::dot(wo, h.wm))) * R / (R + T);
+    const float pr = lobes == bsdf_lobes::transmission ? 0.0f : R;
+    const float pt = lobes == bsdf_lobes::reflection ? 0.0f : T;
+    // Guard: no allowed lobe to sample (R + T = 1 always, but a restriction
+    // may leave the one with probability 0).
+    if (pr == 0.0f && pt == 0.0f) return 0.0f;
+    if (h.reflect) return distrib.pdf(wo, h.wm) / (4.0f * std::abs(glm::dot(wo, h.wm))) * pr / (pr + pt);
     const float denom = sqr(glm::dot(wi, h.wm) + glm::dot(wo, h.wm) / h.etap);
     const float dwm_dwi = std::abs(glm::dot(wi, h.wm)) / denom;
-    return distrib.pdf(wo, h.wm) * dwm_dwi * T / (R + T);
+    return distrib.pdf(wo, h.wm) * dwm_dwi * pt / (pr + pt);
   }
 
-  bool sample(const vec3& wo, float uc, vec2 u, bsdf_sample& out,
-              transport_mode mode = transport_mode::radiance) const {
+  // lobes restricts the choice to reflection or transmission (pbrt-v4's
+  // sampleFlags): the allowed lobe is then taken with probability 1 where
+  // it has any.
+  bool sample(const vec3& wo, float uc, vec2 u, bsdf_sample& out, transport_mode mode = transport_mode::radiance,
+              bsdf_lobes lobes = bsdf_lobes::all) const {
     out = bsdf_sample{};
     // Guard: wo in the tangent plane has no side (and f has 1 / cos theta_o).
     if (wo.z == 0.0f) return false;
     if (is_delta()) {
       // Perfect specular: Fresnel at the macro normal, the lobe chosen by uc.
       const float R = fresnel_dielectric(cos_theta(wo), eta), T = 1.0f - R;
-      if (R == 0.0f && T == 0.0f) return false;
-      if (uc < R / (R + T)) {
+      const float pr = lobes == bsdf_lobes::transmission ? 0.0f : R;
+      const float pt = lobes == bsdf_lobes::reflection ? 0.0f : T;
+      if (pr == 0.0f && pt == 0.0f) return false;
+      if (uc < pr / (pr + pt)) {
         const vec3 wi(-wo.x, -wo.y, wo.z);
         out.wi = wi;
         out.f = color(R / abs_cos_theta(wi));
-        out.pdf = R / (R + T);
+        out.pdf = pr / (pr + pt);
         out.delta = true;
         return true;
       }
@@ -110,7 +120,7 @@ struct dielectric_bsdf {
       if (mode == transport_mode::radiance) ft /= sqr(etap);
       out.wi = wi;
       out.f = color(ft);
-      out.pdf = T / (R + T);
+      out.pdf = pt / (pr + pt);
       out.delta = true;
       out.transmission = true;
       out.eta = etap;
@@ -119,12 +129,14 @@ struct dielectric_bsdf {
     // Rough: a visible normal, Fresnel at it, then the lobe chosen by uc.
     const vec3 wm = distrib.sample_wm(wo, u);
     const float R = fresnel_dielectric(glm::dot(wo, wm), eta), T = 1.0f - R;
-    if (R == 0.0f && T == 0.0f) return false;
-    if (uc < R / (R + T)) {
+    const float pr = lobes == bsdf_lobes::transmission ? 0.0f : R;
+    const float pt = lobes == bsdf_lobes::reflection ? 0.0f : T;
+    if (pr == 0.0f && pt == 0.0f) return false;
+    if (uc < pr / (pr + pt)) {
       const vec3 wi = reflect(wo, wm);
       if (!same_hemisphere(wo, wi)) return false;  // reflected through the surface: no sample (pbrt-v4)
       out.wi = wi;
-      out.pdf = distrib.pdf(wo, wm) / (4.0f * std::abs(glm::dot(wo, wm))) * R / (R + T);
+      out.pdf = distrib.pdf(wo, wm) / (4.0f * std::abs(glm::dot(wo, wm))) * pr / (pr + pt);
       out.f = color(distrib.D(wm) * distrib.G(wo, wi) * R / (4.0f * cos_theta(wi) * cos_theta(wo)));
       return true;
     }
@@ -137,7 +149,7 @@ struct dielectric_bsdf {
     const float denom = sqr(glm::dot(wi, wm) + glm::dot(wo, wm) / etap);
     const float dwm_dwi = std::abs(glm::dot(wi, wm)) / denom;
     out.wi = wi;
-    out.pdf = distrib.pdf(wo, wm) * dwm_dwi * T / (R + T);
+    out.pdf = distrib.pdf(wo, wm) * dwm_dwi * pt / (pr + pt);
     float ft = T * distrib.D(wm) * distrib.G(wo, wi) *
                std::abs(glm::dot(wi, wm) * glm::dot(wo, wm) / (cos_theta(wi) * cos_theta(wo) * denom));
     if (mode == transport_mode::radiance) ft /= sqr(etap);

@@ -9,6 +9,7 @@
 #include "mcrt/core/rng.hpp"
 #include "mcrt/geometry/hit_record.hpp"
 #include "mcrt/materials/diffuse_transmission_material.hpp"
+#include "mcrt/materials/layered_materials.hpp"
 #include "mcrt/materials/microfacet_materials.hpp"
 #include "mcrt/materials/thin_dielectric_material.hpp"
 #include "mcrt/materials/texture.hpp"
@@ -52,19 +53,23 @@ struct diffuse_light {
 };
 
 // pbrt-v4's conductor and dielectric (microfacet_materials.hpp),
-// diffusetransmission (diffuse_transmission_material.hpp) and thindielectric
-// (thin_dielectric_material.hpp) come last: Shirley's scenes pay nothing
-// for them.
-using material = std::variant<lambertian, metal, dielectric, diffuse_light, textured_diffuse, conductor_material,
-                              dielectric_material, diffuse_transmission_material, thin_dielectric_material>;
+// diffusetransmission (diffuse_transmission_material.hpp), thindielectric
+// (thin_dielectric_material.hpp), coateddiffuse and coatedconductor
+// (layered_materials.hpp) come last: Shirley's scenes pay nothing for them.
+using material =
+    std::variant<lambertian, metal, dielectric, diffuse_light, textured_diffuse, conductor_material,
+                 dielectric_material, diffuse_transmission_material, thin_dielectric_material,
+                 coated_diffuse_material, coated_conductor_material>;
 
 // The materials that make a BSDF at a hit (each has at(rec)): pbrt-v4's
-// conductor, dielectric, diffusetransmission and thindielectric. has_bsdf
-// and with_bsdf both read this one list.
+// conductor, dielectric, diffusetransmission, thindielectric,
+// coateddiffuse and coatedconductor. has_bsdf and with_bsdf both read this
+// one list.
 template <class... Ms>
 struct material_list {};
 using bsdf_materials =
-    material_list<conductor_material, dielectric_material, diffuse_transmission_material, thin_dielectric_material>;
+    material_list<conductor_material, dielectric_material, diffuse_transmission_material, thin_dielectric_material,
+                  coated_diffuse_material, coated_conductor_material>;
 
 // Whether m has a BSDF (with_bsdf calls its f): a test the integrators can
 // make before leaving their inlined loop for with_bsdf.

@@ -87,7 +87,24 @@ struct mixture_integrator {
           }
           wi_local = bs.wi;
           f = bs.f;
-          p = bs.delta || lights.empty() ? bs.pdf : 0.5f * (bs.pdf + lights.value(fr.to_world(bs.wi)));
+          if (lights.empty() || bsdf.is_delta()) {
+            p = bs.pdf;
+          } else if (bs.delta) {
+            // A delta lobe of a BSDF that also has others (a smooth coat's
+            // reflection over a layered base): only this branch, taken
+            // with probability 1/2, finds its direction.
+            p = 0.5f * bs.pdf;
+          } else if (bs.pdf_is_proportional) {
+            // A walk's f / pdf is the unbiased weight but its pdf is not the
+            // density of wi: one-sample MIS with the balance heuristic on
+            // the BSDF's pdf p~, the one the light branch divides by
+            // (layered_bsdf.hpp): (f / pdf)_walk p~ / (0.5 (p~ + p_light)).
+            const float pt = bsdf.pdf(wo, bs.wi);
+            f *= pt / bs.pdf;
+            p = 0.5f * (pt + lights.value(fr.to_world(bs.wi)));
+          } else {
+            p = 0.5f * (bs.pdf + lights.value(fr.to_world(bs.wi)));
+          }
         } else {
           light_sample s;
           const std::ptrdiff_t k = lights.generate(2.0f * u_select - 1.0f, ps.get2d(b + layout::light), s);

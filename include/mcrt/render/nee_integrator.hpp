@@ -88,7 +88,10 @@ color sample_direct_light_bsdf(const Scene& sc, const hit_record& rec, const sha
   if (!(p_light > 0.0f) || !std::isfinite(p_light)) return color(0.0f);
   const color le = shadow_ray_radiance(sc, rec.spawn_origin(s.dir), s.dir);
   if (le == color(0.0f)) return color(0.0f);
-  const float w = Weights::light(set, p_light, bsdf.pdf(wo, wi));
+  // The BSDF's pdf only where the weight reads it (a layered BSDF's is a
+  // random walk of its own).
+  const float p_material = Weights::material_counts_listed_lights ? bsdf.pdf(wo, wi) : 0.0f;
+  const float w = Weights::light(set, p_light, p_material);
   return le * f * (w / p_light);
 }
 
@@ -209,7 +212,7 @@ struct next_event_integrator {
       // came from: on an emitter's own surface, its plane's side decides
       // by more than rounding whether its own light faces the point.
       // A surface that transmits takes light from both sides of its horizon.
-      constexpr bool transmits = !std::is_same_v<std::decay_t<decltype(bsdf)>, conductor_bsdf>;
+      constexpr bool transmits = !reflects_only<std::decay_t<decltype(bsdf)>>;
       const light_selection& sel =
           st.select_lights(sc, rec.spawn_origin(-r.d), wo.z < 0.0f ? -fr.z : fr.z, set.choose, transmits);
       if (!bsdf.is_delta())
@@ -223,7 +226,12 @@ struct next_event_integrator {
       const vec3 wi = glm::normalize(fr.to_world(bs.wi));
       st.throughput *= bs.f * (std::abs(bs.wi.z) / bs.pdf);
       st.after_diffuse = !bs.delta;  // st.prev_sel is sel
-      if (!bs.delta) st.prev_p_material = bs.pdf;
+      // The weight of the emission wi meets takes the BSDF's pdf, the one
+      // the light sample's weight took (layered_bsdf.hpp: a walk's own pdf
+      // is not the density of wi).
+      if (!bs.delta)
+        st.prev_p_material =
+            bs.pdf_is_proportional && Weights::material_counts_listed_lights ? bsdf.pdf(wo, bs.wi) : bs.pdf;
       r = {rec.spawn_origin(wi), wi};
       alive = true;
     });
