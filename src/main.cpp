@@ -251,6 +251,7 @@ int run_render(const render_options& opt) {
     j["samples_per_second"] = samples / res.seconds;
     j["light_sampling"] = strategy_used;
     j["integrator"] = opt.integrator;
+    if (!ls.integrator_requested.empty()) j["integrator_requested"] = ls.integrator_requested;
     j["sampler"] = sampler_name;
     j["mis_heuristic"] = opt.mis_heuristic;
     j["light_select"] = light_select;

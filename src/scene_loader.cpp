@@ -458,6 +458,7 @@ loaded_scene load_pbrt_scene(const std::string& path, std::optional<light_sampli
   out.max_depth = b.max_depth;
   out.sampler = b.sampler;
   out.light_select = b.light_select;
+  out.integrator_requested = b.integrator_requested;
   out.output = b.film.filename;
   out.file_lights = std::move(b.file_lights);
   out.auto_lights = b.auto_lights;

@@ -44,6 +44,9 @@ struct loaded_scene {
   // sample generator, the light selection and the output file (its Film's
   // filename); empty for JSON scenes.
   std::string sampler, light_select, output;
+  // pbrt-v4 files: the Integrator the file names (volpath where none);
+  // empty for JSON scenes.
+  std::string integrator_requested;
   // pbrt-v4 files: each light in file order (a mesh's triangles in face
   // order) as its entries in world.emitters (two for a two-sided light).
   std::vector<std::vector<std::uint32_t>> file_lights;

@@ -719,6 +719,30 @@ TEST(PbrtLookAt, EveryViewIsAcceptedWithAnExactAffineMatrix) {
   }
 }
 
+// pbrt-v4's integrators that converge to path's image are accepted with
+// the parameters their Create reads, and the built scene names the one
+// asked for (integrator_requested, for --stats); mcrt renders each with
+// its own integrator, so the scene is otherwise the same.
+TEST(PbrtIntegrators, ThoseThatConvergeToPathsImageAreAccepted) {
+  const std::string world = "WorldBegin\nShape \"sphere\"\n";
+  EXPECT_EQ(from_text(world).integrator_requested, "volpath");  // pbrt-v4's default
+  for (const auto& [type, params] : std::vector<std::pair<std::string, std::string>>{
+           {"path", R"("string lightsampler" "power")"},
+           {"volpath", R"("bool regularize" false)"},
+           {"simplepath", R"("bool samplelights" false "bool samplebsdf" true)"},
+           {"simplepath", ""},
+           {"simplevolpath", ""},
+           {"bdpt", R"("bool visualizestrategies" false "bool visualizeweights" false)"},
+           {"mlt", R"("integer mutationsperpixel" 1000 "integer chains" 10 "float sigma" 0.02 "float largestepprobability" 0.5)"},
+           {"sppm", R"("integer photonsperiteration" 100000 "float radius" 0.05 "integer seed" 3)"}}) {
+    const pbrt::built_scene b =
+        from_text("Integrator \"" + type + "\" \"integer maxdepth\" 7 " + params + "\n" + world);
+    EXPECT_EQ(b.integrator_requested, type);
+    EXPECT_EQ(b.max_depth, 7) << type;
+    EXPECT_EQ(b.spp, from_text(world).spp) << type << ": the Sampler's pixelsamples, whatever the integrator";
+  }
+}
+
 // A light's emitting material reflects with the shape's own material: a
 // white diffuse emitter lit by another light sends back more than its
 // emission (a black one, nothing more).
@@ -1013,7 +1037,12 @@ INSTANTIATE_TEST_SUITE_P(
         refusal{"WorldBegin\nMaterial \"interface\" \"float eta\" 1.5\n", 2, "not supported"},
         refusal{"WorldBegin\nLightSource \"infinite\"\n", 2, "LightSource \"infinite\": not supported"},
         refusal{"Camera \"orthographic\"\nWorldBegin\n", 1, "Camera \"orthographic\": not supported"},
-        refusal{"Integrator \"bdpt\"\nWorldBegin\n", 1, "Integrator \"bdpt\": not supported"},
+        refusal{"Integrator \"randomwalk\"\nWorldBegin\n", 1, "Integrator \"randomwalk\": not supported (its image differs"},
+        refusal{"Integrator \"ambientocclusion\"\nWorldBegin\n", 1, "another quantity"},
+        refusal{"Integrator \"simplepath\" \"bool samplebsdf\" false\nWorldBegin\n", 1, "samplebsdf"},
+        refusal{"Integrator \"bdpt\"\n  \"bool visualizestrategies\" true\nWorldBegin\n", 2, "visualizestrategies"},
+        refusal{"Integrator \"sppm\" \"float radius\" -1\nWorldBegin\n", 1, "radius"},
+        refusal{"Integrator \"bdpt\" \"string lightsampler\" \"power\"\nWorldBegin\n", 1, "lightsampler"},
         refusal{"Integrator \"path\" \"bool regularize\" true\nWorldBegin\n", 1, "regularize"},
         refusal{"Option \"bool wavefront\" true\nWorldBegin\n", 1, "Option \"bool wavefront\": not supported"},
         refusal{"Shape \"sphere\"\n", 1, "before WorldBegin"},

@@ -304,19 +304,69 @@ class builder {
     p.finish();
   }
 
+  // pbrt-v4's integrators. Those that converge to path's image on every
+  // scene mcrt accepts (bdpt, mlt, sppm, simplepath, simplevolpath, and
+  // path and volpath themselves) are rendered by mcrt's own integrator at
+  // the Sampler's pixelsamples, and --stats names the one the file asked
+  // for (integrator_requested); each one's parameters are those its
+  // pbrt-v4 Create reads, checked and otherwise not used (mlt's
+  // mutationsperpixel and sppm's photons set no sample count). Those that
+  // compute another image or another quantity are refused.
   void integrator(const directive& d) {
-    if (d.type != "path" && d.type != "volpath")
-      refuse(d.loc, "Integrator " + quoted(d.type) + ": not supported (supported: path, volpath)");
+    static const std::set<std::string> same_image = {"path", "volpath", "simplepath", "simplevolpath",
+                                                     "bdpt", "mlt", "sppm"};
+    if (d.type == "randomwalk" || d.type == "lightpath")
+      refuse(d.loc, "Integrator " + quoted(d.type) +
+                        ": not supported (its image differs from path's on mirrors, glass and delta lights; "
+                        "supported: path, volpath, simplepath, simplevolpath, bdpt, mlt, sppm)");
+    if (d.type == "ambientocclusion" || d.type == "function")
+      refuse(d.loc, "Integrator " + quoted(d.type) +
+                        ": not supported (it computes another quantity than radiance; supported: path, volpath, "
+                        "simplepath, simplevolpath, bdpt, mlt, sppm)");
+    if (!same_image.contains(d.type))
+      refuse(d.loc, "Integrator " + quoted(d.type) +
+                        ": not supported (supported: path, volpath, simplepath, simplevolpath, bdpt, mlt, sppm)");
+    out_.integrator_requested = d.type;
     params p(d);
     out_.max_depth = p.integer("maxdepth", 5);
     if (out_.max_depth < 0 || out_.max_depth > max_path_depth)
       p.fail("maxdepth must be in [0, " + std::to_string(max_path_depth) + "]");
-    if (p.boolean("regularize", false)) p.fail(*p.find("regularize"), "true is not supported");
-    if (const auto ls = p.string("lightsampler")) {
-      if (*ls == "uniform" || *ls == "power" || *ls == "bvh")
-        out_.light_select = *ls;
-      else
-        p.fail(*p.find("lightsampler"), "must be uniform, power or bvh");
+    if (d.type != "simplepath" && d.type != "simplevolpath" && d.type != "sppm")
+      if (p.boolean("regularize", false)) p.fail(*p.find("regularize"), "true is not supported");
+    if (d.type == "path" || d.type == "volpath") {
+      if (const auto ls = p.string("lightsampler")) {
+        if (*ls == "uniform" || *ls == "power" || *ls == "bvh")
+          out_.light_select = *ls;
+        else
+          p.fail(*p.find("lightsampler"), "must be uniform, power or bvh");
+      }
+    } else if (d.type == "simplepath") {
+      // Without light samples (BSDF samples meeting the emitters) the image
+      // is path's on every scene mcrt accepts (it has no delta lights yet);
+      // without BSDF samples pbrt-v4 samples directions uniformly, which
+      // never finds a mirror's or a pane's direction: another image.
+      p.boolean("samplelights", true);
+      if (!p.boolean("samplebsdf", true))
+        p.fail(*p.find("samplebsdf"), "false is not supported (uniform directions miss every specular surface)");
+    } else if (d.type == "bdpt") {
+      for (const char* v : {"visualizestrategies", "visualizeweights"})
+        if (p.boolean(v, false))
+          p.fail(*p.find(v), "true is not supported (it renders an image per strategy, not the scene)");
+    } else if (d.type == "mlt") {
+      // pbrt-v4's MLTIntegrator::Create: its sample counts and mutation
+      // sizes; mcrt takes the Sampler's pixelsamples instead.
+      for (const char* n : {"bootstrapsamples", "chains", "mutationsperpixel"})
+        if (const param* q = p.find(n); q && p.integer(n, 1) < 1) p.fail(*q, "must be >= 1");
+      const double large = p.real("largestepprobability", 0.3), sigma = p.real("sigma", 0.01);
+      if (!(large >= 0.0 && large <= 1.0)) p.fail(*p.find("largestepprobability"), "must be in [0, 1]");
+      if (!(sigma > 0.0) || !std::isfinite(sigma)) p.fail(*p.find("sigma"), "must be > 0");
+    } else if (d.type == "sppm") {
+      // pbrt-v4's SPPMIntegrator::Create: photons per iteration (-1: one
+      // per pixel), the initial search radius and a seed.
+      p.integer("photonsperiteration", -1);
+      const double radius = p.real("radius", 1.0);
+      if (!(radius > 0.0) || !std::isfinite(radius)) p.fail(*p.find("radius"), "must be > 0");
+      p.accept_any("seed");
     }
     p.finish();
   }

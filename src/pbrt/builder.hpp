@@ -51,6 +51,11 @@ struct built_scene {
   // mcrt's light selection ("power", "uniform" or "bvh", pbrt-v4's default).
   int max_depth = 5;
   std::string light_select = "bvh";
+  // The Integrator the file names (pbrt-v4's default, volpath, where it
+  // names none). mcrt renders every one it accepts with its own
+  // integrator (the command line's, mis by default): they converge to the
+  // same image.
+  std::string integrator_requested = "volpath";
   // The lights in the order the file defines them (a mesh's in face order):
   // each one's entries in world.emitters, two for a two-sided light (its
   // front and its back, each sampled from its own side).

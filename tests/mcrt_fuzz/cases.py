@@ -594,6 +594,18 @@ def lights() -> list[Case]:
                          "bare-roughness": '"float roughness" 0.1', "bare-eta": '"float eta" 1.5'}.items():
         mat(f"coatedconductor-{name}", f'Material "coatedconductor" {params}', expect=REFUSED)
     mat("unknown-material", 'Material "subsurface"', note="an unsupported material")
+    # pbrt-v4's integrators: those that converge to path's image render
+    # (with mis), the others and the visualisations are refused.
+    for name, integ in {"bdpt": '"bdpt"', "mlt": '"mlt" "integer mutationsperpixel" 4', "sppm": '"sppm" "float radius" 0.1',
+                        "simplepath": '"simplepath" "bool samplelights" false', "simplevolpath": '"simplevolpath"'}.items():
+        cases.append(pb(f + f"integrator-{name}", A.pbrt_scene().replace("WorldBegin", f"Integrator {integ}\nWorldBegin", 1),
+                        expect=RENDERED, note=f"Integrator {name}, rendered by mis"))
+    for name, integ in {"randomwalk": '"randomwalk"', "lightpath": '"lightpath"', "ao": '"ambientocclusion"',
+                        "function": '"function"', "bdpt-vis": '"bdpt" "bool visualizeweights" true',
+                        "simplepath-nobsdf": '"simplepath" "bool samplebsdf" false', "mlt-sigma": '"mlt" "float sigma" -1',
+                        "sppm-bogus": '"sppm" "integer iterations" 64'}.items():
+        cases.append(pb(f + f"integrator-{name}", A.pbrt_scene().replace("WorldBegin", f"Integrator {integ}\nWorldBegin", 1),
+                        expect=REFUSED, note=f"Integrator {name}"))
     mat("named-undefined", 'NamedMaterial "nope"', note="NamedMaterial of nothing")
     mat("makenamed-no-type", 'MakeNamedMaterial "m"\nNamedMaterial "m"', note="MakeNamedMaterial without a type")
     # An emitter whose own material reflects hugely, under a huge light.
