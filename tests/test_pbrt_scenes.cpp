@@ -719,6 +719,63 @@ TEST(PbrtLookAt, EveryViewIsAcceptedWithAnExactAffineMatrix) {
   }
 }
 
+// A mix of two materials renders, in expectation, their mix: a floor that
+// mixes a white and a black diffuse material with amount a (the black
+// one's probability) reflects (1 - a) of the white one's light, under
+// every integrator; the choice is a fixed function of the hit (two renders
+// of the same seed are the same image); amount 0 and 1 are the materials
+// themselves; a mix of mixes resolves.
+TEST(PbrtMix, AmountIsTheSecondMaterialsShare) {
+  const auto scene_with = [](const std::string& floor_material) {
+    return from_text(R"(Camera "perspective"
+WorldBegin
+MakeNamedMaterial "white" "string type" "diffuse" "rgb reflectance" [ 0.8 0.8 0.8 ]
+MakeNamedMaterial "black" "string type" "diffuse" "rgb reflectance" [ 0 0 0 ]
+MakeNamedMaterial "half" "string type" "mix" "string materials" [ "white" "black" ]
+)" + floor_material + R"(
+Shape "trianglemesh" "point3 P" [ -5 0 -5  5 0 -5  5 0 5  -5 0 5 ] "integer indices" [ 0 1 2  0 2 3 ]
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [ 4 4 4 ]
+  Material "diffuse" "rgb reflectance" [ 0 0 0 ]
+  Shape "trianglemesh" "point3 P" [ -1 2 -1  -1 2 1  1 2 1  1 2 -1 ] "integer indices" [ 0 2 1  0 3 2 ]
+AttributeEnd
+)");
+  };
+  const std::vector<glm::dvec3> light{{-1, 2, -1}, {-1, 2, 1}, {1, 2, 1}, {1, 2, -1}};
+  for (const auto& [what, material, share] : std::vector<std::tuple<std::string, std::string, double>>{
+           {"amount 0.3", R"(Material "mix" "string materials" [ "white" "black" ] "float amount" 0.3)", 0.7},
+           {"amount 0", R"(Material "mix" "string materials" [ "white" "black" ] "float amount" 0)", 1.0},
+           {"amount 1", R"(Material "mix" "string materials" [ "white" "black" ] "float amount" 1)", 0.0},
+           {"default amount", R"(NamedMaterial "half")", 0.5},
+           {"mix of mixes", R"(MakeNamedMaterial "w" "string type" "mix" "string materials" [ "half" "white" ] "float amount" 0.5
+Material "mix" "string materials" [ "w" "black" ] "float amount" 0.2)", 0.8 * 0.75}}) {
+    const pbrt::built_scene b = scene_with(material);
+    for (const integrator_kind ik : {integrator_kind::mixture, integrator_kind::nee, integrator_kind::mis}) {
+      // The choice is fixed at a hit: the expectation is over hit points.
+      // 3000 points of a 0.2 x 0.2 patch, direct light only, each against
+      // its own irradiance (Lambert's formula); the standard error is that
+      // of the mean difference over the points.
+      pcg32 rng(91, 7);
+      double d_sum = 0.0, d_sq = 0.0, expect_sum = 0.0;
+      const int n = 3000;
+      for (int i = 0; i < n; ++i) {
+        const vec3 x(0.2f * rng.uniform() - 0.1f, 0.0f, 0.2f * rng.uniform() - 0.1f);
+        const ray r{x + vec3(0.3f, 1.0f, 0.2f), -vec3(0.3f, 1.0f, 0.2f)};
+        const test::estimate e =
+            test::radiance_along(b.world, r, path_settings{1, 3}, ik, sampler_kind::independent, 2, 8, i, 17);
+        const double expect = share * 0.8 / std::numbers::pi *
+                              test::polygon_irradiance(glm::dvec3(x), glm::dvec3(0, 1, 0), light, 4.0);
+        d_sum += e.mean - expect;
+        d_sq += (e.mean - expect) * (e.mean - expect);
+        expect_sum += expect;
+      }
+      const double m = d_sum / n, se = std::sqrt(std::max(0.0, d_sq / n - m * m) / (n - 1));
+      EXPECT_NEAR(m, 0.0, 6.0 * se + 1e-4 * expect_sum / n) << what << " " << to_string(ik) << ": mean radiance "
+                                                            << expect_sum / n + m << ", expected " << expect_sum / n;
+    }
+  }
+}
+
 // pbrt-v4's integrators that converge to path's image are accepted with
 // the parameters their Create reads, and the built scene names the one
 // asked for (integrator_requested, for --stats); mcrt renders each with
@@ -1030,6 +1087,8 @@ INSTANTIATE_TEST_SUITE_P(
         refusal{"WorldBegin\nShape \"curve\"\n", 2, "Shape \"curve\": not supported (supported: trianglemesh"},
         refusal{"WorldBegin\nMaterial \"subsurface\"\n", 2, "not supported"},
         refusal{"WorldBegin\nMaterial \"coateddiffuse\"\n  \"integer nsamples\" 0\n", 3, "nsamples"},
+        refusal{"WorldBegin\nMakeNamedMaterial \"a\" \"string type\" \"diffuse\"\nMaterial \"mix\"\n"
+                "  \"string materials\" [ \"a\" \"b\" ]\n", 4, "names no material \"b\""},
         refusal{"WorldBegin\nMaterial \"coatedconductor\" \"rgb reflectance\" [ 1 1 1 ]\n  \"rgb conductor.k\" [ 1 1 1 ]\n",
                 2, "both reflectance and conductor.eta/conductor.k"},
         refusal{"WorldBegin\nMaterial \"interface\"\nAreaLightSource \"diffuse\"\nShape \"sphere\"\n", 3,

@@ -40,8 +40,10 @@ def parse(argv):
     ap.add_argument("--spp", type=int, default=16, help="samples per pixel of each measured run")
     ap.add_argument("--ref-spp", type=int, default=1024, help="samples per pixel of each converged image")
     ap.add_argument("--max-depth", type=int, default=5, help="pbrt-v4's maxdepth (mcrt's --max-depth)")
-    ap.add_argument("--integrator", choices=("path", "volpath"), default="path",
-                    help="the Integrator of the settings copy (mcrt renders both with mis)")
+    ap.add_argument("--integrator", choices=("path", "volpath", "bsdf-only"), default="path",
+                    help="the Integrator of the settings copy (mcrt renders each with mis); bsdf-only: pbrt-v4's "
+                    "simplepath without light samples, whose only estimate is its BSDFs' sampled weight (the "
+                    "reference for its layered BSDFs, whose f() path's light samples use is biased)")
     ap.add_argument("--seeds", type=int, default=8, help="measured runs per renderer (seeds 1..K)")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--grey-lights", action="store_true", help="every rgb L of the top-level file's lights made "

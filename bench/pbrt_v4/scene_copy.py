@@ -127,7 +127,10 @@ def settings_copy(path, width, height, spp, max_depth, integrator="path", grey_l
     sampler += [('"integer pixelsamples"', [str(spp)])]
     new = {"Film": _render("Film", film_kind, film),
            "Sampler": _render("Sampler", sampler_kind, sampler),
-           "Integrator": _render("Integrator", f'"{integrator}"', [('"integer maxdepth"', [str(max_depth)])])}
+           "Integrator": _render("Integrator", '"simplepath"', [('"integer maxdepth"', [str(max_depth)]),
+                                                              ('"bool samplelights"', ["false"])])
+           if integrator == "bsdf-only" else
+           _render("Integrator", f'"{integrator}"', [('"integer maxdepth"', [str(max_depth)])])}
     # Replace back to front so that earlier offsets stay valid.
     edits = [(s[1], s[2], new.pop(k)) for k, s in found.items()]
     if grey_lights:

@@ -24,11 +24,11 @@ constexpr int max_samples_per_pixel = 1 << 20;
 constexpr int max_path_depth = 100000;
 
 
-// The current material when it is "interface": no surface. Shapes made
-// under it are read and checked, and not added (rays pass them, as
-// pbrt-v4's volpath lets every ray through them; its path stops light
-// samples' shadow rays there); an area light on them is refused.
-constexpr std::uint32_t interface_material = 0xfffffffeu;
+// The current material when it is "interface" (interface_material,
+// materials.hpp): no surface. Shapes made under it are read and checked,
+// and not added (rays pass them, as pbrt-v4's volpath lets every ray
+// through them; its path stops light samples' shadow rays there); an area
+// light on them is refused.
 
 // What pbrt-v4's graphics state holds that mcrt uses.
 struct graphics_state {
@@ -470,7 +470,7 @@ class builder {
     if (d.name == "MakeNamedMaterial") p.string("type");
     if (p.find("displacement")) p.fail(*p.find("displacement"), "is not supported");
     if (p.find("normalmap")) p.fail(*p.find("normalmap"), "is not supported");
-    const std::optional<mcrt::material> m = make_material(d.name, type, p, values_);
+    const std::optional<mcrt::material> m = make_material(d.name, type, p, values_, named_materials_);
     p.finish();
     if (!m) return interface_material;
     out_.world.materials.push_back(*m);

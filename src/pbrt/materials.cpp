@@ -92,7 +92,7 @@ layer_parameters layer(params& p, values& v) {
 }  // namespace
 
 std::optional<mcrt::material> make_material(const std::string& directive_name, const std::string& type, params& p,
-                                            values& v) {
+                                            values& v, const std::map<std::string, std::uint32_t>& named) {
   // pbrt-v4's MaterialHandle::Create: "interface" (and the deprecated "none")
   // is no material at all.
   if (type == "interface" || type == "none") return std::nullopt;
@@ -140,10 +140,28 @@ std::optional<mcrt::material> make_material(const std::string& directive_name, c
     c.conductor = conductor(p, v, "conductor.");
     c.layer = layer(p, v);
     m = c;
+  } else if (type == "mix") {
+    // pbrt-v4's MixMaterial: "materials", two named materials defined
+    // before (not interface), and "amount" (default 0.5), the second's
+    // probability.
+    const param* q = p.find("materials");
+    if (!q) p.fail("has no \"string materials\" (two named materials)");
+    p.expect_type(*q, {"string"});
+    if (q->strings.size() != 2) p.fail(*q, "must name two materials");
+    mix_material mx;
+    for (int i = 0; i < 2; ++i) {
+      const auto it = named.find(q->strings[i]);
+      if (it == named.end()) p.fail(*q, "names no material " + quoted(q->strings[i]) + " (MakeNamedMaterial before)");
+      if (it->second == interface_material)
+        p.fail(*q, quoted(q->strings[i]) + " is an interface material, which a mix cannot hold (as in pbrt-v4)");
+      (i == 0 ? mx.first : mx.second) = it->second;
+    }
+    mx.amount = v.float_texture(p, "amount", 0.5f);
+    m = mx;
   } else {
     refuse(p.loc(), directive_name + " " + quoted(type) +
                         ": not supported (supported: diffuse, conductor, dielectric, thindielectric, "
-                        "diffusetransmission, coateddiffuse, coatedconductor, interface)");
+                        "diffusetransmission, coateddiffuse, coatedconductor, mix, interface)");
   }
   return m;
 }

@@ -593,6 +593,22 @@ def lights() -> list[Case]:
                          "k-neg": '"rgb conductor.k" [ -1 -1 -1 ]', "ieta-neg": '"float interface.eta" -1',
                          "bare-roughness": '"float roughness" 0.1', "bare-eta": '"float eta" 1.5'}.items():
         mat(f"coatedconductor-{name}", f'Material "coatedconductor" {params}', expect=REFUSED)
+    # mix: amounts at and beyond the ends, a textured amount, a mix of
+    # mixes; a missing or interface material, one material, refused.
+    named = ('MakeNamedMaterial "a" "string type" "diffuse"\nMakeNamedMaterial "b" "string type" "coateddiffuse"\n'
+             'MakeNamedMaterial "i" "string type" "interface"\n')
+    for name, params in {"default": "", "amount-0": '"float amount" 0', "amount-1": '"float amount" 1',
+                         "amount-neg": '"float amount" -5', "amount-nan-ish": '"float amount" 1e30',
+                         "textured": '"texture amount" "fchecks"'}.items():
+        mat(f"mix-{name}", (pre_tex if "textured" in name else "") + named +
+            f'Material "mix" "string materials" [ "a" "b" ] {params}', expect=RENDERED)
+    mat("mix-of-mix", named + 'MakeNamedMaterial "m" "string type" "mix" "string materials" [ "a" "b" ]\n'
+        'Material "mix" "string materials" [ "m" "a" ] "float amount" 0.3', expect=RENDERED)
+    for name, params in {"missing": '"string materials" [ "a" "nope" ]', "interface": '"string materials" [ "a" "i" ]',
+                         "one": '"string materials" [ "a" ]', "three": '"string materials" [ "a" "b" "a" ]',
+                         "none": '', "not-string": '"float materials" [ 1 2 ]',
+                         "bad-amount": '"string materials" [ "a" "b" ] "string amount" "x"'}.items():
+        mat(f"mix-{name}", named + f'Material "mix" {params}', expect=REFUSED)
     mat("unknown-material", 'Material "subsurface"', note="an unsupported material")
     # pbrt-v4's integrators: those that converge to path's image render
     # (with mis), the others and the visualisations are refused.

@@ -4,6 +4,7 @@
 // std::variant: a scene stores only the materials it names.
 #include <cstdint>
 #include <variant>
+#include <vector>
 
 #include "mcrt/core/ray.hpp"
 #include "mcrt/core/rng.hpp"
@@ -11,6 +12,7 @@
 #include "mcrt/materials/diffuse_transmission_material.hpp"
 #include "mcrt/materials/layered_materials.hpp"
 #include "mcrt/materials/microfacet_materials.hpp"
+#include "mcrt/materials/mix_material.hpp"
 #include "mcrt/materials/thin_dielectric_material.hpp"
 #include "mcrt/materials/texture.hpp"
 #include "mcrt/sampling/warp.hpp"
@@ -55,11 +57,23 @@ struct diffuse_light {
 // pbrt-v4's conductor and dielectric (microfacet_materials.hpp),
 // diffusetransmission (diffuse_transmission_material.hpp), thindielectric
 // (thin_dielectric_material.hpp), coateddiffuse and coatedconductor
-// (layered_materials.hpp) come last: Shirley's scenes pay nothing for them.
+// (layered_materials.hpp) and mix (mix_material.hpp) come last: Shirley's
+// scenes pay nothing for them.
 using material =
     std::variant<lambertian, metal, dielectric, diffuse_light, textured_diffuse, conductor_material,
                  dielectric_material, diffuse_transmission_material, thin_dielectric_material,
-                 coated_diffuse_material, coated_conductor_material>;
+                 coated_diffuse_material, coated_conductor_material, mix_material>;
+
+// The material a hit sees: m itself, or, for a mix (mix_material.hpp), the
+// one it chooses there, mixes within mixes resolved in turn. wo points
+// towards the ray's origin (-r.d). A scene without mixes pays one test of
+// the variant's index.
+inline const material& resolve_mix(const std::vector<material>& materials, const material& m, const hit_record& rec,
+                                   const vec3& wo) {
+  const material* p = &m;
+  while (const auto* mx = std::get_if<mix_material>(p)) p = &materials[mx->choose(rec, wo)];
+  return *p;
+}
 
 // The materials that make a BSDF at a hit (each has at(rec)): pbrt-v4's
 // conductor, dielectric, diffusetransmission, thindielectric,

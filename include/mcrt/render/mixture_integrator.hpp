@@ -36,7 +36,7 @@ struct mixture_integrator {
         if (l->surface == diffuse_light::no_surface) break;
         mp = &sc.materials[l->surface];
       }
-      const material& m = *mp;
+      const material& m = resolve_mix(sc.materials, *mp, rec, -r.d);
       if (depth == set.max_depth) break;
       const int b = layout::bounce(depth);
       if (depth >= set.rr_depth && !survive_roulette(throughput, [&] { return ps.get1d(b + layout::roulette); }))

@@ -146,7 +146,7 @@ struct next_event_integrator {
         if (l->surface == diffuse_light::no_surface) break;
         mp = &sc.materials[l->surface];
       }
-      const material& m = *mp;
+      const material& m = resolve_mix(sc.materials, *mp, rec, -r.d);
       if (depth == set.max_depth) break;
       const int b = layout::bounce(depth);
 
