@@ -1276,7 +1276,9 @@ TEST(Layered, EvalAndSampleAgreeInExpectation) {
               const auto [bm, bs] = mean_se(b_tot, b_tot_sq, n_b, c);
               const auto [tm, ts] = mean_se(all_tot, all_tot_sq, n_b, c);
               EXPECT_NEAR(am, bm, 5.0 * std::hypot(as, bs)) << what << ", channel " << c;
-              if (c == c_max) EXPECT_LE(5.0 * std::hypot(as, bs), 0.03 * bm) << what << ": too loose to mean anything";
+              if (c == c_max) {
+                EXPECT_LE(5.0 * std::hypot(as, bs), 0.03 * bm) << what << ": too loose to mean anything";
+              }
               EXPECT_LE(tm, 1.0 + 5.0 * ts + 1e-5) << what << ", channel " << c;  // + float rounding of weights of exactly 1
               if (lc.conserves) {
                 EXPECT_NEAR(tm, 1.0, 5.0 * ts + 1e-3) << what << ", channel " << c;
@@ -1317,7 +1319,9 @@ TEST(Layered, EstimatesAreDeterministicPositiveAndTwoSided) {
             EXPECT_TRUE(std::isfinite(p)) << lc.name;
             EXPECT_TRUE(glm::all(glm::greaterThanEqual(f, color(0.0f))) && std::isfinite(f.x + f.y + f.z)) << lc.name;
             // Neither base transmits: nothing crosses.
-            if (!same_hemisphere(wo, wi)) EXPECT_EQ(f, color(0.0f)) << lc.name;
+            if (!same_hemisphere(wo, wi)) {
+              EXPECT_EQ(f, color(0.0f)) << lc.name;
+            }
             bsdf_sample s1, s2;
             const float uc = rng.uniform();
             const vec2 u = rng.uniform2();
@@ -1389,7 +1393,9 @@ TEST(HenyeyGreenstein, SampleMatchesDensityAndIntegratesToOne) {
       const vec3 wi = square_to_uniform_sphere(rng.uniform2());
       sum += hg.p(wo, wi) / square_to_uniform_sphere_pdf();
     }
-    if (g != 0.98f) EXPECT_NEAR(sum / n, 1.0, 0.01) << g;
+    if (g != 0.98f) {
+      EXPECT_NEAR(sum / n, 1.0, 0.01) << g;
+    }
     // The sample's pdf is p() at it; the mean cosine of wi with -wo is g.
     double mean_cos = 0.0;
     for (int i = 0; i < n; ++i) {

@@ -156,7 +156,11 @@ TEST(Materials, HasBsdfIsWhatWithBsdfTakes) {
         [&] {
           material m{std::in_place_index<I>};
           if (auto* c = std::get_if<conductor_material>(&m)) c->eta = c->k = one;
-          if (auto* c = std::get_if<coated_conductor_material>(&m)) c->conductor.eta = c->conductor.k = one;
+          if (auto* c = std::get_if<coated_conductor_material>(&m)) {
+            auto q = std::make_shared<coated_conductor_parameters>();
+            q->conductor.eta = q->conductor.k = one;
+            c->p = q;
+          }
           bool called = false;
           const bool taken = with_bsdf(m, rec, [&](const auto&) { called = true; });
           EXPECT_EQ(taken, called) << "alternative " << I;

@@ -126,20 +126,20 @@ std::optional<mcrt::material> make_material(const std::string& directive_name, c
     m = t;
   } else if (type == "coateddiffuse") {
     // pbrt-v4's CoatedDiffuseMaterial::Create.
-    coated_diffuse_material c;
-    c.reflectance = v.spectrum_texture(p, "reflectance", color(0.5f));
-    c.eta = ior(p, v);
-    c.roughness = roughness(p, v);
-    c.layer = layer(p, v);
-    m = c;
+    auto c = std::make_shared<coated_diffuse_parameters>();
+    c->reflectance = v.spectrum_texture(p, "reflectance", color(0.5f));
+    c->eta = ior(p, v);
+    c->roughness = roughness(p, v);
+    c->layer = layer(p, v);
+    m = coated_diffuse_material{c};
   } else if (type == "coatedconductor") {
     // pbrt-v4's CoatedConductorMaterial::Create.
-    coated_conductor_material c;
-    c.interface_eta = ior(p, v, "interface.eta");
-    c.interface_roughness = roughness(p, v, "interface.");
-    c.conductor = conductor(p, v, "conductor.");
-    c.layer = layer(p, v);
-    m = c;
+    auto c = std::make_shared<coated_conductor_parameters>();
+    c->interface_eta = ior(p, v, "interface.eta");
+    c->interface_roughness = roughness(p, v, "interface.");
+    c->conductor = conductor(p, v, "conductor.");
+    c->layer = layer(p, v);
+    m = coated_conductor_material{c};
   } else if (type == "mix") {
     // pbrt-v4's MixMaterial: "materials", two named materials defined
     // before (not interface), and "amount" (default 0.5), the second's

@@ -52,20 +52,11 @@ inline constexpr bool reflects_only<coated_conductor_bsdf> = true;
 // Plastic, varnished wood, paint: a dielectric coat (eta, default 1.5;
 // roughness default 0) over a Lambertian base of `reflectance` (default
 // 0.5, clamped to [0, 1]).
-struct coated_diffuse_material {
+struct coated_diffuse_parameters {
   std::shared_ptr<const texture> reflectance;  // null: 0.5
   float eta = 1.5f;
   microfacet_roughness roughness;
   layer_parameters layer;
-
-  coated_diffuse_bsdf at(const hit_record& rec) const {
-    coated_diffuse_bsdf b;
-    b.top.eta = eta;
-    b.top.distrib = roughness.at(rec);
-    b.bottom.R = reflectance ? glm::clamp(reflectance->eval(rec.uv), color(0.0f), color(1.0f)) : color(0.5f);
-    layer.apply(rec, b);
-    return b;
-  }
 };
 
 // Lacquered metal: a dielectric coat (interface.eta, default 1.5;
@@ -73,20 +64,46 @@ struct coated_diffuse_material {
 // conductor.k, default copper, or `reflectance`; conductor.*roughness,
 // default 0). The conductor's IOR is relative to the coat: pbrt-v4 divides
 // eta and k by the coat's eta.
-struct coated_conductor_material {
+struct coated_conductor_parameters {
   float interface_eta = 1.5f;
   microfacet_roughness interface_roughness;
   conductor_material conductor;  // its eta, k or reflectance and roughness
   layer_parameters layer;
+};
+
+// The materials hold their parameters by pointer: a material is an
+// alternative of one variant (material.hpp), whose size is its largest
+// alternative's, and every scene's materials would otherwise pay for the
+// two dozen words of these. A null pointer is pbrt-v4's defaults (a
+// coated conductor then needs its conductor's IOR).
+struct coated_diffuse_material {
+  std::shared_ptr<const coated_diffuse_parameters> p;
+
+  coated_diffuse_bsdf at(const hit_record& rec) const {
+    static const coated_diffuse_parameters defaults;
+    const coated_diffuse_parameters& q = p ? *p : defaults;
+    coated_diffuse_bsdf b;
+    b.top.eta = q.eta;
+    b.top.distrib = q.roughness.at(rec);
+    b.bottom.R = q.reflectance ? glm::clamp(q.reflectance->eval(rec.uv), color(0.0f), color(1.0f)) : color(0.5f);
+    q.layer.apply(rec, b);
+    return b;
+  }
+};
+
+struct coated_conductor_material {
+  std::shared_ptr<const coated_conductor_parameters> p;
 
   coated_conductor_bsdf at(const hit_record& rec) const {
+    static const coated_conductor_parameters defaults;
+    const coated_conductor_parameters& q = p ? *p : defaults;
     coated_conductor_bsdf b;
-    b.top.eta = interface_eta;
-    b.top.distrib = interface_roughness.at(rec);
-    b.bottom = conductor.at(rec);
-    b.bottom.eta /= interface_eta;
-    b.bottom.k /= interface_eta;
-    layer.apply(rec, b);
+    b.top.eta = q.interface_eta;
+    b.top.distrib = q.interface_roughness.at(rec);
+    b.bottom = q.conductor.at(rec);
+    b.bottom.eta /= q.interface_eta;
+    b.bottom.k /= q.interface_eta;
+    q.layer.apply(rec, b);
     return b;
   }
 };

@@ -64,15 +64,31 @@ using material =
                  dielectric_material, diffuse_transmission_material, thin_dielectric_material,
                  coated_diffuse_material, coated_conductor_material, mix_material>;
 
+// Every scene's material list pays for the largest alternative: the big
+// ones (the coats) hold their parameters by pointer, so that a material
+// stays within the conductor's 88 bytes and the variant's index.
+static_assert(sizeof(material) <= 96, "a material alternative grew the variant: hold its parameters by pointer");
+
 // The material a hit sees: m itself, or, for a mix (mix_material.hpp), the
 // one it chooses there, mixes within mixes resolved in turn. wo points
 // towards the ray's origin (-r.d). A scene without mixes pays one test of
 // the variant's index.
-inline const material& resolve_mix(const std::vector<material>& materials, const material& m, const hit_record& rec,
-                                   const vec3& wo) {
+#if defined(__GNUC__) || defined(__clang__)
+[[gnu::noinline]]
+#endif
+inline const material&
+resolve_mix_chain(const std::vector<material>& materials, const material& m, const hit_record& rec, const vec3& wo) {
   const material* p = &m;
   while (const auto* mx = std::get_if<mix_material>(p)) p = &materials[mx->choose(rec, wo)];
   return *p;
+}
+// The test inline, the choice out of line: the integrators' loop stays as
+// it was for scenes without mixes.
+inline const material& resolve_mix(const std::vector<material>& materials, const material& m, const hit_record& rec,
+                                   const vec3& wo) {
+  if (!std::holds_alternative<mix_material>(m)) [[likely]]
+    return m;
+  return resolve_mix_chain(materials, m, rec, wo);
 }
 
 // The materials that make a BSDF at a hit (each has at(rec)): pbrt-v4's
