@@ -115,8 +115,7 @@ struct layered_bsdf {
       {
         const float uc = r();
         const vec2 u = uniform2(r);
-        const bool ok = exit_top ? top.sample(wi, uc, u, wis, adjoint(mode), bsdf_lobes::transmission)
-                                 : bottom.sample(wi, uc, u, wis, adjoint(mode), bsdf_lobes::transmission);
+        const bool ok = sample_at(exit_top, wi, uc, u, wis, adjoint(mode), bsdf_lobes::transmission);
         if (!ok || !usable(wis)) continue;
       }
 
@@ -184,8 +183,7 @@ struct layered_bsdf {
           bsdf_sample bs;
           const float uc = r();
           const vec2 u = uniform2(r);
-          const bool ok = exit_top ? top.sample(-w, uc, u, bs, mode, bsdf_lobes::reflection)
-                                   : bottom.sample(-w, uc, u, bs, mode, bsdf_lobes::reflection);
+          const bool ok = sample_at(exit_top, -w, uc, u, bs, mode, bsdf_lobes::reflection);
           if (!ok || !usable(bs)) break;
           beta *= bs.f * abs_cos_theta(bs.wi) / bs.pdf;
           w = bs.wi;
@@ -207,8 +205,7 @@ struct layered_bsdf {
           bsdf_sample bs;
           const float uc = r();
           const vec2 u = uniform2(r);
-          const bool ok = exit_top ? bottom.sample(-w, uc, u, bs, mode, bsdf_lobes::reflection)
-                                   : top.sample(-w, uc, u, bs, mode, bsdf_lobes::reflection);
+          const bool ok = sample_at(!exit_top, -w, uc, u, bs, mode, bsdf_lobes::reflection);
           if (!ok || !usable(bs)) break;
           beta *= bs.f * abs_cos_theta(bs.wi) / bs.pdf;
           w = bs.wi;
@@ -300,7 +297,7 @@ struct layered_bsdf {
       // Scattering at the interface the walk reached.
       const float iuc = r();
       const vec2 iu = uniform2(r);
-      const bool ok = z == 0.0f ? bottom.sample(-w, iuc, iu, bs, mode) : top.sample(-w, iuc, iu, bs, mode);
+      const bool ok = sample_at(z != 0.0f, -w, iuc, iu, bs, mode, bsdf_lobes::all);
       if (!ok || !usable(bs)) return false;
       specular_path = specular_path && bs.delta;
       w = bs.wi;
@@ -405,6 +402,12 @@ struct layered_bsdf {
   float exit_pdf_of(bool exit_top, const vec3& wi, const vec3& d, transport_mode mode) const {
     return exit_top ? top.pdf(wi, d, adjoint(mode), bsdf_lobes::transmission)
                     : bottom.pdf(wi, d, adjoint(mode), bsdf_lobes::transmission);
+  }
+
+  // The sample of the top interface (at_top) or of the bottom one.
+  bool sample_at(bool at_top, const vec3& wo, float uc, vec2 u, bsdf_sample& out, transport_mode mode,
+                 bsdf_lobes lobes) const {
+    return at_top ? top.sample(wo, uc, u, out, mode, lobes) : bottom.sample(wo, uc, u, out, mode, lobes);
   }
 
   // A sample the walk can continue from (pbrt-v4's checks: some f, a
